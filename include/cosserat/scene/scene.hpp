@@ -1,0 +1,126 @@
+#pragma once
+// A validated scene: the only thing the rest of the solver reads from a scene file
+// (shared/spec/SCENE_FORMAT.md). Data flows one way: file -> Scene -> Simulation.
+
+#include <array>
+#include <limits>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cosserat/model/material.hpp"
+#include "cosserat/model/vec3.hpp"
+
+namespace cosserat {
+
+// Bad input. what() is the full message: file, key, line where known, what is allowed.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class Integrator {
+  verlet,
+  symplectic_euler,
+  euler,
+  midpoint,
+  rk4,
+  leapfrog,
+  velocity_verlet,
+  tc_verlet,
+  verlet_lagged,
+};
+
+// Names as written in scene files, in the order of the enum.
+const std::vector<std::string>& integrator_names();
+std::optional<Integrator> integrator_from_name(const std::string& name);
+const std::string& integrator_name(Integrator integrator);
+
+enum class Borders { symmetric, published };
+
+struct NodeIndex {
+  int k = 0;
+  int l = 0;
+  bool operator==(const NodeIndex&) const = default;
+};
+
+// A set of grid nodes, already expanded from its scene form (list, rect, disk, row, column)
+// and checked to lie inside the grid.
+struct NodeSet {
+  std::vector<NodeIndex> nodes;
+};
+
+// Step windows are inclusive: a constraint acts during step s when start <= s <= end.
+struct Fix {
+  NodeSet nodes;
+  std::array<bool, 3> axes{true, true, true};
+  long start = 0;
+  long end = std::numeric_limits<long>::max();
+};
+
+struct Load {
+  NodeSet nodes;
+  Vec3 force;  // newtons on each node (MODEL.md §1)
+  long start = 0;
+  long end = std::numeric_limits<long>::max();
+};
+
+struct Fluid {
+  double viscosity = 0.0;  // rho_R
+  Vec3 velocity;           // u
+};
+
+struct Scene {
+  std::string path;   // the file it came from
+  std::string text;   // the scene text as read
+  std::string name;   // file stem: default output name
+  std::string title;
+  std::vector<std::string> overrides;  // the --set arguments applied, as given
+
+  // [grid]
+  int m = 0;  // nodes along x1
+  int n = 0;  // nodes along x2
+  double size1 = 0.0;
+  double size2 = 0.0;
+  Vec3 origin;
+  Vec3 u{1.0, 0.0, 0.0};  // normalised
+  Vec3 v{0.0, 0.0, 1.0};  // normalised
+
+  // [material], after the preset and overrides; mass = total kg (density converted)
+  Material material;
+
+  // [model]
+  Borders borders = Borders::symmetric;
+
+  // [environment]
+  Vec3 gravity;
+  double damping = 0.0;
+  Vec3 initial_velocity;
+  std::optional<Fluid> fluid;
+
+  // [time]
+  Integrator integrator = Integrator::verlet;
+  double dt = 0.0;
+  long steps = 0;
+  long output_every = 0;  // 0: only the first and the last frame
+
+  std::vector<Fix> fixes;
+  std::vector<Load> loads;
+
+  // Warnings the loader found (e.g. a coupling that breaks positive definiteness).
+  std::vector<std::string> warnings;
+
+  double h1() const { return size1 / (m - 1); }
+  double h2() const { return size2 / (n - 1); }
+};
+
+// Reads and validates a scene file. `overrides` are "dotted.key=toml-value" strings applied
+// on top of the file before validation. Throws SceneError on any bad input.
+Scene load_scene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Same, from text already in memory (`path` is used in messages only).
+Scene parse_scene(const std::string& text, const std::string& path,
+                  const std::vector<std::string>& overrides = {});
+
+}  // namespace cosserat
