@@ -1,0 +1,69 @@
+#pragma once
+// The local block of the global m x n grid that one rank owns, with ghost layers around it
+// (DESIGN.md principle 1). Every loop in the solver runs over global indices (k, l) inside the
+// block's owned range, so the same code serves one rank and many; physical-border rules test
+// the global index, never the block edge.
+
+#include <mpi.h>
+
+#include <cassert>
+#include <cstddef>
+#include <vector>
+
+namespace cosserat {
+
+// Ghost width: a node's force reads positions up to two nodes away (MODEL.md §2.4; the
+// derivation is next to the kernel in model/cosserat_model.cpp).
+inline constexpr int kGhostWidth = 2;
+
+struct Block {
+  MPI_Comm comm = MPI_COMM_WORLD;
+  int m = 0, n = 0;    // global grid
+  int k0 = 0, k1 = 0;  // owned k range [k0, k1)
+  int l0 = 0, l1 = 0;  // owned l range [l0, l1)
+  int ghost = kGhostWidth;
+
+  // The whole grid as one block: the decomposition of a single rank.
+  static Block whole(int m, int n, MPI_Comm comm = MPI_COMM_WORLD) {
+    return Block{comm, m, n, 0, m, 0, n, kGhostWidth};
+  }
+
+  int owned_k() const { return k1 - k0; }
+  int owned_l() const { return l1 - l0; }
+  long owned_nodes() const { return static_cast<long>(owned_k()) * owned_l(); }
+  int stride() const { return owned_k() + 2 * ghost; }
+  std::size_t local_size() const {
+    return static_cast<std::size_t>(stride()) * (owned_l() + 2 * ghost);
+  }
+  // Storage index of global node (k, l); x1 (k) is the fastest index.
+  std::size_t index(int k, int l) const {
+    assert(k >= k0 - ghost && k < k1 + ghost && l >= l0 - ghost && l < l1 + ghost);
+    return static_cast<std::size_t>(k - k0 + ghost) +
+           static_cast<std::size_t>(l - l0 + ghost) * static_cast<std::size_t>(stride());
+  }
+  bool owns(int k, int l) const { return k >= k0 && k < k1 && l >= l0 && l < l1; }
+};
+
+// One value per node of a block, ghosts included, in one contiguous array.
+template <class T>
+class Field {
+ public:
+  Field() = default;
+  explicit Field(const Block& block) : block_(&block), data_(block.local_size()) {}
+
+  T& operator()(int k, int l) { return data_[block_->index(k, l)]; }
+  const T& operator()(int k, int l) const { return data_[block_->index(k, l)]; }
+  T* data() { return data_.data(); }
+  const T* data() const { return data_.data(); }
+  const Block& block() const { return *block_; }
+  void swap(Field& other) noexcept {
+    std::swap(block_, other.block_);
+    data_.swap(other.data_);
+  }
+
+ private:
+  const Block* block_ = nullptr;
+  std::vector<T> data_;
+};
+
+}  // namespace cosserat

@@ -1,0 +1,64 @@
+#pragma once
+// Internal force of the elastic Cosserat surface (MODEL.md §1–§2) on a local block.
+
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/model/material.hpp"
+#include "cosserat/model/vec3.hpp"
+
+namespace cosserat {
+
+enum class Borders;
+
+// Rest data of a flat sheet: uniform, so kept as constants (MODEL.md §3).
+struct RestState {
+  Sym2 metric{};          // A_ab
+  Sym2 inverse_metric{};  // A^ab
+  Sym2 Phi{}, Psi{}, Theta{};  // MODEL.md §1, from the material and A^ab
+};
+
+// Rest state of a flat sheet spanned by unit vectors u (x1) and v (x2).
+RestState flat_rest_state(const Material& material, const Vec3& u, const Vec3& v);
+
+// Everything the force phase needs from one node's geometry and resultants (MODEL.md §2.1).
+struct NodeResultants {
+  Vec3 a1, a2, normal;
+  double N11, N12, N21, N22;  // N^{ab}: membrane resultants less the curvature coupling
+  double M11, M12, M22;       // bending moments M^{ab} (symmetric)
+  double shear_christoffel1, shear_christoffel2;  // Γ·M part of N^{3a}
+  double christoffel_trace1, christoffel_trace2;  // Σ_λ Γ^λ_aλ, for the divergence
+};
+
+class CosseratModel {
+ public:
+  CosseratModel(const Block& block, double h1, double h2, const RestState& rest,
+                Borders borders);
+
+  // Internal force per unit current area at every owned node, for the area factor f = 1:
+  // the physical force is (S0/S) times this (MODEL.md §1), so the internal acceleration is
+  // this times S0/M whatever the current area. Reads positions up to two nodes outside the
+  // owned range (ghosts must be current).
+  void internal_force(const Field<Vec3>& positions, Field<Vec3>& force);
+
+  // Unit normals of the owned nodes from the last internal_force call.
+  Vec3 normal(int k, int l) const { return resultants_(k, l).normal; }
+
+ private:
+  void compute_resultants(const Field<Vec3>& r, int k, int l);
+  Vec3 traction1(int k, int l) const;
+  Vec3 traction2(int k, int l) const;
+
+  const Block* block_;
+  double h1_, h2_;
+  RestState rest_;
+  bool symmetric_borders_;
+  Field<NodeResultants> resultants_;
+  Field<Vec3> traction1_, traction2_;
+};
+
+// This block's share of the total area S: the two triangles of every cell whose lower-left
+// node it owns (MODEL.md §3), summed row by row in a fixed order.
+double block_area(const Field<Vec3>& positions);
+
+}  // namespace cosserat

@@ -1,0 +1,42 @@
+#pragma once
+// Fixed nodes with axis masks and step windows (MODEL.md §4.1), for the nodes this block owns.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/model/vec3.hpp"
+#include "cosserat/scene/scene.hpp"
+
+namespace cosserat {
+
+class Constraints {
+ public:
+  Constraints(const std::vector<Fix>& fixes, const Block& block);
+
+  // Switches the fixes acting during `step` on and off. A component that becomes held keeps
+  // the value it has now (MODEL.md §4.1), not its rest value.
+  void begin_step(long step, const Field<Vec3>& positions);
+
+  // Held components back to their held value / to zero velocity.
+  void hold_positions(Field<Vec3>& positions) const;
+  void hold_velocities(Field<Vec3>& velocities) const;
+
+  bool empty() const { return nodes_.empty(); }
+
+ private:
+  struct Window {
+    std::uint8_t axes;  // bit c set: component c held
+    long start, end;
+  };
+  struct HeldNode {
+    int k, l;
+    std::vector<Window> windows;
+    std::uint8_t held = 0;
+    Vec3 value;
+  };
+  std::vector<HeldNode> nodes_;
+};
+
+}  // namespace cosserat

@@ -1,0 +1,59 @@
+#pragma once
+// The right-hand side of the equation of motion (MODEL.md §1, §4): internal force plus exactly
+// the external terms the scene declares (DESIGN.md principle 3).
+
+#include <optional>
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/scene/scene.hpp"
+
+namespace cosserat {
+
+// Coefficients of the terms linear in velocity, per unit mass: the acceleration is
+// a_free − damping v − fluid (n·v) n (MODEL.md §4).
+struct VelocityTerms {
+  double damping = 0.0;  // ϱ_D / μ
+  double fluid = 0.0;    // ϱ_R / μ
+};
+
+class Dynamics {
+ public:
+  Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions);
+
+  // The velocity-free part of the acceleration at `step` into `a`, and the coefficients of
+  // the velocity terms, for schemes that treat those at the step's centre.
+  VelocityTerms free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a);
+
+  // The whole acceleration A(r, v) at `step`.
+  void acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step, Field<Vec3>& a);
+
+  // Unit normal of an owned node at the last evaluated positions (fluid term).
+  Vec3 normal(int k, int l) const { return model_.normal(k, l); }
+
+  bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
+  double rest_area() const { return rest_area_; }
+  double mass() const { return mass_; }
+  double total_area(const Field<Vec3>& r) const;  // S, a global reduction
+
+ private:
+  struct PointLoad {
+    int k, l;
+    Vec3 force;
+    long start, end;
+  };
+
+  const Block* block_;
+  CosseratModel model_;
+  double h1h2_;
+  double mass_;
+  double rest_area_;
+  Vec3 gravity_;
+  double damping_;
+  std::optional<Fluid> fluid_;
+  std::vector<PointLoad> loads_;
+  bool needs_area_;
+};
+
+}  // namespace cosserat

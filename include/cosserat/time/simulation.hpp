@@ -1,0 +1,55 @@
+#pragma once
+// A scene set up on this rank's block: rest state, dynamics, constraints and integrator
+// (DESIGN.md principle 4: scene -> Simulation -> step loop -> writers).
+
+#include <mpi.h>
+
+#include <optional>
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/stepper.hpp"
+
+namespace cosserat {
+
+// Whole-sheet quantities reported in the run summary; all global reductions.
+struct Diagnostics {
+  double area_ratio = 0.0;      // S / S0
+  double kinetic_energy = 0.0;  // ½ Σ (M/(m n)) |v|²: the mass shared equally by the nodes
+  double max_speed = 0.0;
+  Vec3 center_of_mass;          // mean node position
+};
+
+class Simulation {
+ public:
+  Simulation(const Scene& scene, MPI_Comm comm);
+  Simulation(const Simulation&) = delete;
+  Simulation& operator=(const Simulation&) = delete;
+
+  std::optional<Instability> step() { return stepper_.step(); }
+  long step_index() const { return stepper_.step_index(); }
+  double time() const { return stepper_.time(); }
+  const Block& block() const { return block_; }
+  const Field<Vec3>& positions() const { return stepper_.positions(); }
+  const Field<Vec3>& velocities() { return stepper_.velocities(); }
+  Dynamics& dynamics() { return dynamics_; }
+
+  Diagnostics diagnostics();
+
+  // Positions of the whole grid laid out [m][n][3] (l fastest), as the output file stores
+  // them; complete on rank 0.
+  std::vector<double> gather_positions() const;
+
+ private:
+  static Field<Vec3> rest_positions(const Scene& scene, const Block& block);
+  static Field<Vec3> initial_velocities(const Scene& scene, const Block& block);
+
+  const Scene* scene_;
+  Block block_;
+  Dynamics dynamics_;
+  Stepper stepper_;
+};
+
+}  // namespace cosserat

@@ -1,0 +1,71 @@
+#pragma once
+// The explicit time integrators of MODEL.md §4, each applying the constraints of §4.1 after
+// every stage, and the stability monitor of §4.2.
+
+#include <optional>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/constraints.hpp"
+#include "cosserat/time/dynamics.hpp"
+
+namespace cosserat {
+
+// Where and when a run became unstable (MODEL.md §4.2).
+struct Instability {
+  long step;    // the step whose new state failed the check
+  double time;  // its time
+  int k, l;
+  bool not_finite;  // else: moved more than half a grid spacing
+};
+
+class Stepper {
+ public:
+  // Takes the state at step 0: positions with ghosts, velocities.
+  Stepper(const Scene& scene, const Block& block, Dynamics& dynamics,
+          const Field<Vec3>& positions, const Field<Vec3>& velocities);
+
+  // Advances one step. On instability the state is left at the last good step and the
+  // failure is returned.
+  std::optional<Instability> step();
+
+  long step_index() const { return step_; }
+  double time() const { return time_; }
+  const Field<Vec3>& positions() const { return r_; }
+  // The scheme's velocity at the current time; for the Verlet family, which carries none,
+  // the backward difference (r − r⁻)/Δt, the velocity half a step back.
+  const Field<Vec3>& velocities();
+
+ private:
+  void start();
+  void verlet_step();
+  void verlet_lagged_step();
+  void leapfrog_step();
+  void euler_step(bool symplectic);
+  void midpoint_step();
+  void rk4_step();
+  void velocity_verlet_step();
+  std::optional<Instability> check(const Field<Vec3>& next) const;
+  void hold(Field<Vec3>& r, Field<Vec3>& v) const;
+
+  const Scene* scene_;
+  const Block* block_;
+  Dynamics* dynamics_;
+  Constraints constraints_;
+  Integrator scheme_;
+  double dt_;
+  double dt_previous_;  // Δt_{n−1} of tc-verlet; the scene's step is constant
+  double max_move_;     // half the smaller grid spacing (MODEL.md §4.2)
+  long step_ = 0;
+  double time_ = 0.0;
+
+  Field<Vec3> r_, v_;   // current state (v: v^{n−½} for leapfrog)
+  Field<Vec3> r_next_;  // the new positions before acceptance
+  Field<Vec3> r_prev_;  // Verlet family: r⁻
+  Field<Vec3> a_;       // acceleration (velocity-verlet keeps it across steps)
+  Field<Vec3> r_stage_, v_stage_, r_sum_, v_sum_;  // Runge–Kutta stages
+  bool velocities_current_ = false;
+  Field<Vec3> v_report_;
+};
+
+}  // namespace cosserat

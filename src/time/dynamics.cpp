@@ -1,0 +1,78 @@
+#include "cosserat/time/dynamics.hpp"
+
+#include "cosserat/grid/reduce.hpp"
+
+namespace cosserat {
+
+Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions)
+    : block_(&block),
+      model_(block, scene.h1(), scene.h2(),
+             flat_rest_state(scene.material, scene.u, scene.v), scene.borders),
+      h1h2_(scene.h1() * scene.h2()),
+      mass_(scene.material.mass),
+      rest_area_(total_area(rest_positions)),
+      gravity_(scene.gravity),
+      damping_(scene.damping),
+      fluid_(scene.fluid) {
+  for (const Load& load : scene.loads)
+    for (const NodeIndex& node : load.nodes.nodes)
+      if (block.owns(node.k, node.l))
+        loads_.push_back(PointLoad{node.k, node.l, load.force, load.start, load.end});
+  // μ = M/S enters only through loads, fluid and damping (MODEL.md §3): without them the
+  // current area is never needed during a step.
+  // The area is a collective reduction: decide from the scene, which every rank shares.
+  needs_area_ = !scene.loads.empty() || fluid_.has_value() || damping_ > 0.0;
+}
+
+double Dynamics::total_area(const Field<Vec3>& r) const {
+  return global_sum(block_area(r), block_->comm);
+}
+
+VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a) {
+  const Block& b = *block_;
+  model_.internal_force(r, a);
+  // S/M = 1/μ; the internal force carries f = S0/S, so its acceleration is f̂ S0/M (§3).
+  const double inverse_density = needs_area_ ? total_area(r) / mass_ : 0.0;
+  const double internal_scale = rest_area_ / mass_;
+  const Vec3 g = gravity_;
+  const bool fluid = fluid_.has_value();
+  const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
+  const Vec3 fluid_velocity = fluid ? fluid_->velocity : Vec3{};
+
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      Vec3 acc = internal_scale * a(k, l) + g;
+      if (fluid) {
+        const Vec3 n = model_.normal(k, l);
+        acc += (fluid_coefficient * dot(n, fluid_velocity)) * n;
+      }
+      a(k, l) = acc;
+    }
+  // Point loads are newtons on the node's lumped mass μ h1 h2 (MODEL.md §1).
+  for (const PointLoad& load : loads_)
+    if (load.start <= step && step <= load.end)
+      a(load.k, load.l) += (inverse_density / h1h2_) * load.force;
+  return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
+}
+
+void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step,
+                            Field<Vec3>& a) {
+  const VelocityTerms terms = free_acceleration(r, step, a);
+  if (!has_velocity_terms()) return;
+  const Block& b = *block_;
+  const bool fluid = fluid_.has_value();
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      const Vec3 vel = v(k, l);
+      Vec3 acc = a(k, l) - terms.damping * vel;
+      if (fluid) {
+        const Vec3 n = model_.normal(k, l);
+        acc -= (terms.fluid * dot(n, vel)) * n;
+      }
+      a(k, l) = acc;
+    }
+}
+
+}  // namespace cosserat

@@ -1,0 +1,106 @@
+#include "cosserat/time/simulation.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "cosserat/grid/reduce.hpp"
+
+namespace cosserat {
+
+namespace {
+
+Block single_block(const Scene& scene, MPI_Comm comm) {
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  if (ranks != 1)
+    throw std::runtime_error(
+        "this build runs on one MPI rank; subdomain decomposition is not implemented yet");
+  return Block::whole(scene.m, scene.n, comm);
+}
+
+}  // namespace
+
+Field<Vec3> Simulation::rest_positions(const Scene& scene, const Block& block) {
+  Field<Vec3> r(block);
+  const double h1 = scene.h1(), h2 = scene.h2();
+  // Ghost nodes inside the grid get their rest positions too, so a block's first force
+  // evaluation reads real data whatever the decomposition.
+  const int k_lo = std::max(block.k0 - block.ghost, 0), k_hi = std::min(block.k1 + block.ghost, block.m);
+  const int l_lo = std::max(block.l0 - block.ghost, 0), l_hi = std::min(block.l1 + block.ghost, block.n);
+  for (int l = l_lo; l < l_hi; ++l)
+    for (int k = k_lo; k < k_hi; ++k)
+      r(k, l) = scene.origin + (k * h1) * scene.u + (l * h2) * scene.v;
+  return r;
+}
+
+Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& block) {
+  Field<Vec3> v(block);
+  for (int l = block.l0; l < block.l1; ++l)
+    for (int k = block.k0; k < block.k1; ++k) v(k, l) = scene.initial_velocity;
+  return v;
+}
+
+Simulation::Simulation(const Scene& scene, MPI_Comm comm)
+    : scene_(&scene),
+      block_(single_block(scene, comm)),
+      dynamics_(scene, block_, rest_positions(scene, block_)),
+      stepper_(scene, block_, dynamics_, rest_positions(scene, block_),
+               initial_velocities(scene, block_)) {}
+
+Diagnostics Simulation::diagnostics() {
+  const Block& b = block_;
+  const Field<Vec3>& r = stepper_.positions();
+  const Field<Vec3>& v = stepper_.velocities();
+  // Per-row partials summed in row order: the same result for any thread count.
+  const auto rows = static_cast<std::size_t>(b.owned_l());
+  std::vector<double> speed2(rows), max_speed2(rows);
+  std::vector<Vec3> position_sum(rows);
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l) {
+    const auto row = static_cast<std::size_t>(l - b.l0);
+    double s2 = 0.0, max2 = 0.0;
+    Vec3 sum;
+    for (int k = b.k0; k < b.k1; ++k) {
+      const double w2 = dot(v(k, l), v(k, l));
+      s2 += w2;
+      max2 = std::max(max2, w2);
+      sum += r(k, l);
+    }
+    speed2[row] = s2;
+    max_speed2[row] = max2;
+    position_sum[row] = sum;
+  }
+  double s2 = 0.0, max2 = 0.0;
+  Vec3 sum;
+  for (std::size_t row = 0; row < rows; ++row) {
+    s2 += speed2[row];
+    max2 = std::max(max2, max_speed2[row]);
+    sum += position_sum[row];
+  }
+  const double nodes = static_cast<double>(b.m) * b.n;
+  Diagnostics d;
+  d.area_ratio = dynamics_.total_area(r) / dynamics_.rest_area();
+  d.kinetic_energy = 0.5 * (scene_->material.mass / nodes) * global_sum(s2, b.comm);
+  d.max_speed = std::sqrt(global_max(max2, b.comm));
+  d.center_of_mass = Vec3{global_sum(sum.x, b.comm), global_sum(sum.y, b.comm),
+                          global_sum(sum.z, b.comm)} / nodes;
+  return d;
+}
+
+std::vector<double> Simulation::gather_positions() const {
+  const Block& b = block_;
+  const Field<Vec3>& r = stepper_.positions();
+  std::vector<double> out(static_cast<std::size_t>(b.m) * b.n * 3);
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      const std::size_t at = (static_cast<std::size_t>(k) * b.n + l) * 3;
+      const Vec3 p = r(k, l);
+      out[at] = p.x;
+      out[at + 1] = p.y;
+      out[at + 2] = p.z;
+    }
+  return out;
+}
+
+}  // namespace cosserat

@@ -1,0 +1,54 @@
+#pragma once
+// Scenes built in code for tests: a flat sheet with the SCENES.md defaults, to be varied.
+
+#include <cmath>
+#include <vector>
+
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/simulation.hpp"
+
+namespace cosserat::testing {
+
+// m x n sheet, 10 m x 10 m in the xz plane, SCENES.md default material, no terms at all.
+inline Scene flat_sheet(int m, int n) {
+  Scene s;
+  s.name = "test";
+  s.m = m;
+  s.n = n;
+  s.size1 = 10.0;
+  s.size2 = 10.0;
+  s.u = {1.0, 0.0, 0.0};
+  s.v = {0.0, 0.0, 1.0};
+  s.material.mass = 10.0;
+  s.material.zeta = {100.0, 100.0, 100.0};
+  s.material.xi = {0.3, 0.3, 0.3};
+  s.material.phi = {0.001, 0.001, 0.001};
+  s.dt = 1e-3;
+  s.steps = 0;
+  s.output_every = 1;
+  return s;
+}
+
+inline Fix fix_nodes(std::vector<NodeIndex> nodes) {
+  Fix f;
+  f.nodes.nodes = std::move(nodes);
+  return f;
+}
+
+// Every node of column k (all l).
+inline Fix fix_column(int k, int n) {
+  Fix f;
+  for (int l = 0; l < n; ++l) f.nodes.nodes.push_back({k, l});
+  return f;
+}
+
+inline double distance(const Vec3& a, const Vec3& b) { return norm(a - b); }
+
+// Runs `steps` steps; fails the test (returns false) on instability.
+inline bool advance(Simulation& sim, long steps) {
+  for (long i = 0; i < steps; ++i)
+    if (sim.step()) return false;
+  return true;
+}
+
+}  // namespace cosserat::testing
