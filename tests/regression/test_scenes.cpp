@@ -1,0 +1,72 @@
+// The reference scenes end to end, as shipped in scenes/ (SCENES.md, MODEL.md §5 item 5).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "support/sheets.hpp"
+
+namespace cosserat {
+namespace {
+
+std::string scene_file(const std::string& name) {
+  return std::string(COSSERAT_SOURCE_DIR) + "/scenes/" + name;
+}
+
+// S1 at its default Δt: stable for all 10 000 steps, settles (kinetic energy below 1e-3 of
+// its peak) and keeps its area within 10 % (SCENES.md "What to record").
+TEST(Clothesline, StableSettlesAndKeepsItsArea) {
+  const Scene scene = load_scene(scene_file("s1_clothesline.toml"));
+  Simulation sim(scene, MPI_COMM_SELF);
+  double peak = 0.0, energy = 0.0;
+  while (sim.step_index() < scene.steps) {
+    ASSERT_FALSE(sim.step()) << "unstable at step " << sim.step_index();
+    if (sim.step_index() % 10 == 0) {
+      energy = sim.diagnostics().kinetic_energy;
+      peak = std::max(peak, energy);
+    }
+  }
+  const Diagnostics end = sim.diagnostics();
+  std::printf("[S1] peak kinetic energy %.4g J, final %.4g J, area ratio %.5f\n", peak,
+              end.kinetic_energy, end.area_ratio);
+  EXPECT_GT(peak, 0.0);
+  EXPECT_LT(end.kinetic_energy, 1e-3 * peak);
+  EXPECT_NEAR(end.area_ratio, 1.0, 0.1);
+}
+
+double largest_out_of_plane(const Simulation& sim) {
+  const Block& b = sim.block();
+  double largest = 0.0;
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) largest = std::max(largest, std::abs(sim.positions()(k, l).y));
+  return largest;
+}
+
+// S6 with φ = 0.1: all 20 000 steps stable and the sheet folds out of its plane from in-plane
+// loads alone. With φ = 0 nothing couples stretch to bending: it stays exactly planar.
+TEST(Compression, FoldsWithCouplingAndStaysPlanarWithout) {
+  {
+    const Scene scene = load_scene(scene_file("s6_compression.toml"));
+    ASSERT_DOUBLE_EQ(scene.material.phi[0], 0.1);
+    Simulation sim(scene, MPI_COMM_SELF);
+    ASSERT_EQ(scene.steps, 20000);
+    ASSERT_TRUE(testing::advance(sim, scene.steps)) << "unstable before step 20000";
+    const double fold = largest_out_of_plane(sim);
+    std::printf("[S6] phi = 0.1: largest out-of-plane displacement %.4f m, area ratio %.4f\n",
+                fold, sim.diagnostics().area_ratio);
+    // A clear margin: more than a tenth of the grid spacing (0.17 m).
+    EXPECT_GT(fold, 0.1 * scene.h1());
+  }
+  {
+    const Scene scene = load_scene(scene_file("s6_compression.toml"), {"material.phi=0.0"});
+    Simulation sim(scene, MPI_COMM_SELF);
+    ASSERT_TRUE(testing::advance(sim, scene.steps));
+    const double fold = largest_out_of_plane(sim);
+    std::printf("[S6] phi = 0: largest out-of-plane displacement %.3e m\n", fold);
+    EXPECT_EQ(fold, 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace cosserat
