@@ -1,0 +1,39 @@
+#pragma once
+// The run summary: one JSON object whose keys are fixed by shared/DESIGN.md ("Interfaces"),
+// read by scripts that compare runs, so names and types here do not change.
+
+#include <optional>
+#include <string>
+
+#include "cosserat/model/vec3.hpp"
+
+namespace cosserat {
+
+struct RunSummary {
+  std::string scene;
+  int m = 0;
+  int n = 0;
+  int ranks = 1;
+  int threads = 1;
+  std::string integrator;
+  double dt = 0.0;
+  long steps = 0;
+  double sim_time = 0.0;
+  double wall_seconds = 0.0;
+  double node_steps_per_second = 0.0;
+  std::string status;  // "ok" or "unstable"
+  std::optional<long> unstable_step;
+  double area_ratio = 0.0;  // S / S0 at the end
+  double max_speed = 0.0;
+  double kinetic_energy = 0.0;
+  Vec3 center_of_mass;
+  std::string output;  // the HDF5 file written
+};
+
+// Non-finite numbers and an empty unstable_step are written as null, since JSON has no NaN.
+std::string to_json(const RunSummary& summary);
+
+// Throws std::runtime_error naming path when the file cannot be written.
+void write_summary(const std::string& path, const RunSummary& summary);
+
+}  // namespace cosserat

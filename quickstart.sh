@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# The README's two commands, for a fresh Debian 12 machine (as root, or with sudo):
+#   bash quickstart.sh demo   install what is missing, build, run S1, render s1_clothesline.png
+#   bash quickstart.sh test   install what is missing, build, run every test
+set -euo pipefail
+cd "$(dirname "$0")"
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config git
+  libopenmpi-dev openmpi-bin libhdf5-openmpi-dev hdf5-tools
+  libtomlplusplus-dev libcli11-dev libfmt-dev libeigen3-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  python3 python3-numpy python3-h5py python3-matplotlib
+)
+BUILD_DIR=build/release
+
+install_missing() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  echo "installing: ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo=sudo
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+}
+
+build() {
+  cmake --preset release >/dev/null
+  cmake --build --preset release -j "$(nproc)"
+}
+
+# Open MPI refuses to start as root unless told; everything here runs as root.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+
+case "${1:-}" in
+  demo)
+    install_missing
+    build
+    "$BUILD_DIR/cosserat" run scenes/s1_clothesline.toml --output s1_clothesline.h5 \
+      --summary s1_clothesline.json
+    /usr/bin/python3 tools/render.py s1_clothesline.h5 --output s1_clothesline.png
+    echo "wrote s1_clothesline.h5 (+ .xmf for ParaView), s1_clothesline.json, s1_clothesline.png"
+    ;;
+  test)
+    install_missing
+    build
+    ctest --preset release -j "$(nproc)"
+    ;;
+  *)
+    echo "usage: bash quickstart.sh demo|test" >&2
+    exit 2
+    ;;
+esac

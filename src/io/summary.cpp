@@ -1,0 +1,84 @@
+#include "cosserat/io/summary.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace cosserat {
+namespace {
+
+std::string json_string(const std::string& text) {
+  std::string quoted = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"': quoted += "\\\""; break;
+      case '\\': quoted += "\\\\"; break;
+      case '\n': quoted += "\\n"; break;
+      case '\r': quoted += "\\r"; break;
+      case '\t': quoted += "\\t"; break;
+      case '\b': quoted += "\\b"; break;
+      case '\f': quoted += "\\f"; break;
+      default:
+        // Other control characters have no short escape; bytes from 0x80 up are UTF-8 and JSON
+        // takes them as they are.
+        if (static_cast<unsigned char>(c) < 0x20) {
+          quoted += fmt::format("\\u{:04x}", static_cast<unsigned char>(c));
+        } else {
+          quoted += c;
+        }
+    }
+  }
+  return quoted + '"';
+}
+
+// fmt's default is the shortest text that reads back as the same double, so every bit of the
+// value survives without the noise digits of a fixed %.17g ("0.001", not
+// "0.0010000000000000000208"). JSON has no NaN or infinity.
+std::string json_number(double value) {
+  return std::isfinite(value) ? fmt::format("{}", value) : "null";
+}
+
+}  // namespace
+
+std::string to_json(const RunSummary& s) {
+  const std::string unstable_step =
+      s.unstable_step ? fmt::format("{}", *s.unstable_step) : "null";
+  const Vec3& com = s.center_of_mass;
+  return fmt::format(
+      R"({{
+  "scene": {},
+  "grid": [{}, {}],
+  "ranks": {},
+  "threads": {},
+  "integrator": {},
+  "dt": {},
+  "steps": {},
+  "sim_time": {},
+  "wall_seconds": {},
+  "node_steps_per_second": {},
+  "status": {},
+  "unstable_step": {},
+  "area_ratio": {},
+  "max_speed": {},
+  "kinetic_energy": {},
+  "center_of_mass": [{}, {}, {}],
+  "output": {}
+}}
+)",
+      json_string(s.scene), s.m, s.n, s.ranks, s.threads, json_string(s.integrator),
+      json_number(s.dt), s.steps, json_number(s.sim_time), json_number(s.wall_seconds),
+      json_number(s.node_steps_per_second), json_string(s.status), unstable_step,
+      json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
+      json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output));
+}
+
+void write_summary(const std::string& path, const RunSummary& summary) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out << to_json(summary);
+  out.close();
+  if (!out) throw std::runtime_error(fmt::format("summary file '{}': write failed", path));
+}
+
+}  // namespace cosserat
