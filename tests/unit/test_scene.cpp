@@ -1,0 +1,706 @@
+// Scene loader (shared/spec/SCENE_FORMAT.md): valid scenes give the right values and defaults;
+// every bad input is one SceneError naming the file, the key and what is allowed.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "cosserat/scene/scene.hpp"
+
+namespace cosserat {
+namespace {
+
+using ::testing::AllOf;
+using ::testing::HasSubstr;
+using ::testing::StartsWith;
+
+constexpr const char* kPath = "scenes/test.toml";
+
+// A valid scene, one section at a time, so a test changes only what it is about.
+struct SceneText {
+  std::string top;
+  std::string grid = "nodes = [10, 12]\nsize = [10.0, 5.0]\n";
+  std::string material = "mass = 10.0\nzeta = 100.0\nxi = 0.3\nphi = 0.001\n";
+  std::string time = "dt = 0.001\nsteps = 1000\n";
+  std::string tail;
+
+  std::string str() const {
+    return top + "[grid]\n" + grid + "\n[material]\n" + material + "\n[time]\n" + time + "\n" +
+           tail;
+  }
+};
+
+Scene parse(const SceneText& text, const std::vector<std::string>& overrides = {}) {
+  return parse_scene(text.str(), kPath, overrides);
+}
+
+// The message of the SceneError that parsing must throw.
+std::string error_of(const SceneText& text, const std::vector<std::string>& overrides = {}) {
+  try {
+    parse(text, overrides);
+  } catch (const SceneError& error) {
+    const std::string message = error.what();
+    EXPECT_THAT(message, StartsWith(kPath));
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    return message;
+  }
+  ADD_FAILURE() << "expected a SceneError";
+  return {};
+}
+
+std::set<std::pair<int, int>> node_pairs(const NodeSet& set) {
+  std::set<std::pair<int, int>> pairs;
+  for (const auto& node : set.nodes) pairs.insert({node.k, node.l});
+  return pairs;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Valid scenes
+
+TEST(Scene, MinimalSceneHasTheDocumentedDefaults) {
+  const Scene scene = parse(SceneText{});
+  EXPECT_EQ(scene.path, kPath);
+  EXPECT_EQ(scene.name, "test");
+  EXPECT_EQ(scene.title, "");
+  EXPECT_EQ(scene.m, 10);
+  EXPECT_EQ(scene.n, 12);
+  EXPECT_DOUBLE_EQ(scene.size1, 10.0);
+  EXPECT_DOUBLE_EQ(scene.size2, 5.0);
+  EXPECT_DOUBLE_EQ(scene.h1(), 10.0 / 9.0);
+  EXPECT_DOUBLE_EQ(scene.h2(), 5.0 / 11.0);
+  EXPECT_EQ(norm(scene.origin), 0.0);
+  EXPECT_EQ(norm(scene.u - Vec3{1, 0, 0}), 0.0);
+  EXPECT_EQ(norm(scene.v - Vec3{0, 0, 1}), 0.0);
+  EXPECT_DOUBLE_EQ(scene.material.mass, 10.0);
+  EXPECT_EQ(scene.material.zeta, (Sym2{100.0, 100.0, 100.0}));
+  EXPECT_EQ(scene.material.xi, (Sym2{0.3, 0.3, 0.3}));
+  EXPECT_EQ(scene.material.phi, (Sym2{0.001, 0.001, 0.001}));
+  EXPECT_EQ(scene.borders, Borders::symmetric);
+  EXPECT_EQ(norm(scene.gravity), 0.0);
+  EXPECT_EQ(scene.damping, 0.0);
+  EXPECT_EQ(norm(scene.initial_velocity), 0.0);
+  EXPECT_FALSE(scene.fluid.has_value());
+  EXPECT_EQ(scene.integrator, Integrator::verlet);
+  EXPECT_DOUBLE_EQ(scene.dt, 0.001);
+  EXPECT_EQ(scene.steps, 1000);
+  EXPECT_EQ(scene.output_every, 10);
+  EXPECT_TRUE(scene.fixes.empty());
+  EXPECT_TRUE(scene.loads.empty());
+  EXPECT_TRUE(scene.warnings.empty());
+  EXPECT_EQ(scene.text, SceneText{}.str());
+}
+
+TEST(Scene, OutputEveryIsAtLeastOne) {
+  SceneText text;
+  text.time = "dt = 0.001\nsteps = 50\n";
+  EXPECT_EQ(parse(text).output_every, 1);
+}
+
+TEST(Scene, EveryKeyIsRead) {
+  SceneText text;
+  text.top = "title = \"everything\"\n";
+  text.grid += "origin = [1, 2, 3]\nu = [2.0, 0.0, 0.0]\nv = [0.0, 3.0, 4.0]\n";
+  text.material =
+      "mass = 7\nzeta = [100, 110, 120]\nxi = [0.1, 0.2, 0.3]\nphi = [0.01, 0.02, 0.03]\n";
+  text.time = "integrator = \"rk4\"\ndt = 0.002\nsteps = 10\noutput_every = 5\n";
+  text.tail = R"(
+[model]
+kind = "cosserat"
+borders = "published"
+
+[environment]
+gravity = [0.0, -9.8, 0.0]
+damping = 0.2
+initial_velocity = [0.0, 0.0, 1.0]
+
+[environment.fluid]
+viscosity = 0.032
+velocity = [100.0, 0.0, 0.0]
+
+[[fix]]
+nodes = [[0, 0], [0, 11]]
+axes = "xz"
+start = 3
+end = 20001
+
+[[load]]
+nodes = [[5, 6]]
+force = [0.5, 0.0, -0.5]
+end = 7
+)";
+  const Scene scene = parse(text);
+  EXPECT_EQ(scene.title, "everything");
+  EXPECT_EQ(scene.origin.z, 3.0);
+  EXPECT_EQ(norm(scene.u - Vec3{1, 0, 0}), 0.0);
+  EXPECT_NEAR(norm(scene.v - Vec3{0, 0.6, 0.8}), 0.0, 1e-15);
+  EXPECT_EQ(scene.material.zeta, (Sym2{100, 110, 120}));
+  EXPECT_EQ(scene.material.xi, (Sym2{0.1, 0.2, 0.3}));
+  EXPECT_EQ(scene.material.phi, (Sym2{0.01, 0.02, 0.03}));
+  EXPECT_EQ(scene.borders, Borders::published);
+  EXPECT_EQ(scene.gravity.y, -9.8);
+  EXPECT_EQ(scene.damping, 0.2);
+  EXPECT_EQ(scene.initial_velocity.z, 1.0);
+  ASSERT_TRUE(scene.fluid.has_value());
+  EXPECT_EQ(scene.fluid->viscosity, 0.032);
+  EXPECT_EQ(scene.fluid->velocity.x, 100.0);
+  EXPECT_EQ(scene.integrator, Integrator::rk4);
+  EXPECT_EQ(scene.output_every, 5);
+  ASSERT_EQ(scene.fixes.size(), 1u);
+  EXPECT_EQ(scene.fixes[0].nodes.nodes, (std::vector<NodeIndex>{{0, 0}, {0, 11}}));
+  EXPECT_EQ(scene.fixes[0].axes, (std::array<bool, 3>{true, false, true}));
+  EXPECT_EQ(scene.fixes[0].start, 3);
+  EXPECT_EQ(scene.fixes[0].end, 20001);
+  ASSERT_EQ(scene.loads.size(), 1u);
+  EXPECT_EQ(scene.loads[0].force.z, -0.5);
+  EXPECT_EQ(scene.loads[0].start, 0);
+  EXPECT_EQ(scene.loads[0].end, 7);
+}
+
+TEST(Scene, FixDefaultsHoldEveryAxisForTheWholeRun) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[1, 1]]\n";
+  const Fix fix = parse(text).fixes.at(0);
+  EXPECT_EQ(fix.axes, (std::array<bool, 3>{true, true, true}));
+  EXPECT_EQ(fix.start, 0);
+  EXPECT_EQ(fix.end, std::numeric_limits<long>::max());
+}
+
+TEST(Scene, PresetGivesEverythingAndScalesMassToTheSheet) {
+  SceneText text;
+  text.grid = "nodes = [5, 5]\nsize = [5.0, 4.0]\n";
+  text.material = "preset = \"silk\"\n";
+  const Scene scene = parse(text);
+  EXPECT_DOUBLE_EQ(scene.material.mass, 78.0 * 20.0 / 100.0);
+  EXPECT_EQ(scene.material.zeta, (Sym2{100, 100, 100}));
+  EXPECT_EQ(scene.material.xi, (Sym2{0.01, 0.01, 0.01}));
+  EXPECT_EQ(scene.material.phi, (Sym2{0.1, 0.1, 0.1}));
+}
+
+TEST(Scene, KeysBesidePresetOverrideIt) {
+  SceneText text;
+  text.material = "preset = \"denim\"\nxi = [0.1, 0.2, 0.3]\nmass = 3.0\n";
+  const Scene scene = parse(text);
+  EXPECT_EQ(scene.material.mass, 3.0);
+  EXPECT_EQ(scene.material.xi, (Sym2{0.1, 0.2, 0.3}));
+  EXPECT_EQ(scene.material.zeta, (Sym2{100, 100, 100}));
+}
+
+TEST(Scene, DensityConvertsToTotalMass) {
+  SceneText text;
+  text.material = "density = 0.25\nzeta = 100.0\nxi = 0.3\nphi = 0.001\n";
+  EXPECT_DOUBLE_EQ(parse(text).material.mass, 0.25 * 10.0 * 5.0);
+}
+
+TEST(Scene, PresetTableIsThePublishedOne) {
+  ASSERT_EQ(material_presets().size(), 12u);
+  const auto canvas = find_preset("coated-cotton");
+  ASSERT_TRUE(canvas.has_value());
+  EXPECT_EQ(canvas->mass_10x10, 125.0);
+  EXPECT_EQ(canvas->zeta, 200.0);
+  EXPECT_EQ(canvas->xi, 0.05);
+  EXPECT_EQ(canvas->phi, 0.01);
+  EXPECT_FALSE(find_preset("tweed").has_value());
+}
+
+TEST(Scene, IntegratorNamesFollowTheEnum) {
+  const auto& names = integrator_names();
+  ASSERT_EQ(names.size(), 9u);
+  EXPECT_EQ(names.front(), "verlet");
+  EXPECT_EQ(names.back(), "verlet-lagged");
+  for (const auto& name : names) EXPECT_EQ(integrator_name(*integrator_from_name(name)), name);
+  EXPECT_EQ(integrator_from_name("tc-verlet"), Integrator::tc_verlet);
+  EXPECT_FALSE(integrator_from_name("Verlet").has_value());
+}
+
+TEST(Scene, RegionsExpandToGridNodes) {
+  SceneText text;
+  text.tail = R"(
+[[fix]]
+region = { rect = [1, 2, 3, 3] }
+[[fix]]
+region = { disk = { center = [5, 5], radius = 1.5 } }
+[[fix]]
+region = { row = 11 }
+[[fix]]
+region = { column = 0 }
+[[load]]
+region = { disk = { center = [4.5, 5.5], radius = 0.75 } }
+force = [0, 1, 0]
+)";
+  const Scene scene = parse(text);
+  EXPECT_EQ(node_pairs(scene.fixes[0].nodes),
+            (std::set<std::pair<int, int>>{{1, 2}, {2, 2}, {3, 2}, {1, 3}, {2, 3}, {3, 3}}));
+  EXPECT_EQ(scene.fixes[1].nodes.nodes.size(), 9u);
+  EXPECT_EQ(scene.fixes[2].nodes.nodes.size(), 10u);
+  for (const auto& node : scene.fixes[2].nodes.nodes) EXPECT_EQ(node.l, 11);
+  EXPECT_EQ(scene.fixes[3].nodes.nodes.size(), 12u);
+  for (const auto& node : scene.fixes[3].nodes.nodes) EXPECT_EQ(node.k, 0);
+  EXPECT_EQ(node_pairs(scene.loads[0].nodes),
+            (std::set<std::pair<int, int>>{{4, 5}, {5, 5}, {4, 6}, {5, 6}}));
+}
+
+TEST(Scene, PositiveDefinitenessIsAWarningNotAnError) {
+  SceneText text;
+  text.material = "mass = 1\nzeta = 100\nxi = [0.3, 0.0001, 0.3]\nphi = 1.0\n";
+  const Scene scene = parse(text);
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_THAT(scene.warnings[0],
+              AllOf(StartsWith(kPath), HasSubstr("component 12"), HasSubstr("positive definite")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// --set
+
+TEST(SceneSet, ArrayValue) {
+  const Scene scene = parse(SceneText{}, {"grid.nodes=[1024, 1024]"});
+  EXPECT_EQ(scene.m, 1024);
+  EXPECT_EQ(scene.n, 1024);
+  EXPECT_EQ(scene.overrides, (std::vector<std::string>{"grid.nodes=[1024, 1024]"}));
+}
+
+TEST(SceneSet, QuotedString) {
+  EXPECT_EQ(parse(SceneText{}, {"time.integrator=\"midpoint\""}).integrator, Integrator::midpoint);
+}
+
+TEST(SceneSet, BareWordIsAString) {
+  EXPECT_EQ(parse(SceneText{}, {"time.integrator = leapfrog"}).integrator, Integrator::leapfrog);
+}
+
+TEST(SceneSet, NumberReplacesTheFileValue) {
+  EXPECT_EQ(parse(SceneText{}, {"time.dt=0.0005", "time.steps=4"}).dt, 0.0005);
+}
+
+TEST(SceneSet, CreatesMissingTables) {
+  const Scene scene =
+      parse(SceneText{}, {"environment.fluid.viscosity=0.5", "environment.fluid.velocity=[1, 2, 3]",
+                          "model.borders=published"});
+  ASSERT_TRUE(scene.fluid.has_value());
+  EXPECT_EQ(scene.fluid->viscosity, 0.5);
+  EXPECT_EQ(scene.fluid->velocity.y, 2.0);
+  EXPECT_EQ(scene.borders, Borders::published);
+}
+
+TEST(SceneSet, WithoutEqualsIsRejected) {
+  EXPECT_THAT(error_of(SceneText{}, {"time.dt"}),
+              AllOf(HasSubstr("--set 'time.dt'"), HasSubstr("dotted.key=value")));
+}
+
+TEST(SceneSet, EmptyKeyIsRejected) {
+  EXPECT_THAT(error_of(SceneText{}, {"=3"}), AllOf(HasSubstr("--set"), HasSubstr("empty key")));
+  EXPECT_THAT(error_of(SceneText{}, {"time..dt=3"}),
+              AllOf(HasSubstr("--set"), HasSubstr("empty key")));
+}
+
+TEST(SceneSet, MalformedArrayIsNotTakenAsAString) {
+  EXPECT_THAT(error_of(SceneText{}, {"grid.nodes=[4, 4"}),
+              AllOf(HasSubstr("--set 'grid.nodes=[4, 4'"), HasSubstr("not a TOML value")));
+}
+
+TEST(SceneSet, PathThroughAValueIsRejected) {
+  EXPECT_THAT(error_of(SceneText{}, {"time.dt.x=3"}),
+              AllOf(HasSubstr("--set"), HasSubstr("'time.dt' is the number 0.001, not a table")));
+}
+
+TEST(SceneSet, ErrorsNameTheCommandLineInsteadOfALine) {
+  EXPECT_THAT(error_of(SceneText{}, {"time.dt=-0.1"}),
+              AllOf(HasSubstr(std::string(kPath) + " (from --set): key 'time.dt'"),
+                    HasSubstr("must be > 0, got -0.1")));
+  EXPECT_THAT(error_of(SceneText{}, {"time.stepz=4"}),
+              AllOf(HasSubstr("(from --set): key 'time.stepz'"), HasSubstr("unknown key")));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Bad input: one message each, naming the key and what is allowed
+
+TEST(SceneError, NotToml) {
+  SceneText text;
+  text.top = "title = \n";
+  EXPECT_THAT(error_of(text),
+              AllOf(StartsWith(std::string(kPath) + ":1:"), HasSubstr("not valid TOML")));
+}
+
+TEST(SceneError, UnknownTopLevelKey) {
+  SceneText text;
+  text.top = "titel = \"typo\"\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(StartsWith(std::string(kPath) + ":1: key 'titel'"), HasSubstr("unknown key"),
+                    HasSubstr("allowed here: title, grid")));
+}
+
+TEST(SceneError, UnknownKeyInATable) {
+  SceneText text;
+  text.grid += "spacing = 1.0\n";
+  EXPECT_THAT(error_of(text), AllOf(StartsWith(std::string(kPath) + ":4: key 'grid.spacing'"),
+                                    HasSubstr("allowed here: nodes, size, origin, u, v")));
+}
+
+TEST(SceneError, UnknownKeyInANestedTable) {
+  SceneText text;
+  text.tail = "[environment.fluid]\nviscosity = 1\nvelocity = [1, 0, 0]\ndensity = 1.2\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.fluid.density'"),
+                                    HasSubstr("allowed here: viscosity, velocity")));
+}
+
+TEST(SceneError, UnknownKeyInAFixBlock) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[0, 0]]\n[[fix]]\nnodes = [[0, 1]]\naxis = \"x\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[1].axis'"),
+                                    HasSubstr("allowed here: nodes, region, axes, start, end")));
+}
+
+TEST(SceneError, UnknownKeyInARegion) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { square = [0, 0, 1, 1] }\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].region.square'"),
+                                    HasSubstr("allowed here: rect, disk, row, column")));
+}
+
+TEST(SceneError, WrongType) {
+  SceneText text;
+  text.time = "dt = \"fast\"\nsteps = 10\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'time.dt'"),
+                                    HasSubstr("must be a number, got the string \"fast\"")));
+}
+
+TEST(SceneError, FloatWhereAnIntegerIsExpected) {
+  SceneText text;
+  text.time = "dt = 0.001\nsteps = 1e4\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'time.steps'"), HasSubstr("must be an integer")));
+}
+
+TEST(SceneError, WrongArrayLength) {
+  SceneText text;
+  text.tail = "[environment]\ngravity = [0, -9.8]\n";
+  EXPECT_THAT(
+      error_of(text),
+      AllOf(HasSubstr("key 'environment.gravity'"),
+            HasSubstr("must be an array of 3 numbers [x, y, z], got an array of 2 entries")));
+}
+
+TEST(SceneError, MissingRequiredKey) {
+  SceneText text;
+  text.time = "dt = 0.001\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'time.steps'"), HasSubstr("required: an integer >= 0")));
+}
+
+TEST(SceneError, MissingRequiredTable) {
+  try {
+    parse_scene("[grid]\nnodes = [3, 3]\nsize = [1, 1]\n", kPath);
+    ADD_FAILURE() << "expected a SceneError";
+  } catch (const SceneError& error) {
+    EXPECT_THAT(error.what(), AllOf(HasSubstr("key 'material'"), HasSubstr("required")));
+  }
+}
+
+TEST(SceneError, GridSmallerThanThreeByThree) {
+  SceneText text;
+  text.grid = "nodes = [10, 2]\nsize = [1.0, 1.0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'grid.nodes[1]'"), HasSubstr("must be >= 3"),
+                                    HasSubstr("grids smaller than 3x3 are rejected")));
+}
+
+TEST(SceneError, SizeNotPositive) {
+  SceneText text;
+  text.grid = "nodes = [10, 10]\nsize = [1.0, 0.0]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'grid.size[1]'"), HasSubstr("must be > 0, got 0")));
+}
+
+TEST(SceneError, ZeroLengthDirection) {
+  SceneText text;
+  text.grid += "u = [0, 0, 0]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'grid.u'"), HasSubstr("must not be zero-length")));
+}
+
+TEST(SceneError, ParallelDirections) {
+  SceneText text;
+  text.grid += "u = [1, 0, 1]\nv = [-2, 0, -2]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'grid.v'"), HasSubstr("must not be parallel to grid.u")));
+}
+
+TEST(SceneError, NonFiniteNumber) {
+  SceneText text;
+  text.tail = "[environment]\ndamping = nan\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.damping'"),
+                                    HasSubstr("must be a finite number, got nan")));
+  text.tail = "[environment]\ngravity = [0, -inf, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.gravity[1]'"),
+                                    HasSubstr("must be a finite number, got -inf")));
+}
+
+TEST(SceneError, TimeStepNotPositive) {
+  SceneText text;
+  text.time = "dt = -0.1\nsteps = 10\n";
+  EXPECT_THAT(error_of(text),
+              HasSubstr(std::string(kPath) + ":12: key 'time.dt': must be > 0, got -0.1"));
+}
+
+TEST(SceneError, NegativeSteps) {
+  SceneText text;
+  text.time = "dt = 0.1\nsteps = -1\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'time.steps'"), HasSubstr("must be >= 0, got -1")));
+}
+
+TEST(SceneError, OutputEveryBelowOne) {
+  SceneText text;
+  text.time += "output_every = 0\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'time.output_every'"), HasSubstr("must be >= 1")));
+}
+
+TEST(SceneError, UnknownIntegrator) {
+  SceneText text;
+  text.time += "integrator = \"rk45\"\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'time.integrator'"), HasSubstr("unknown integrator \"rk45\""),
+                    HasSubstr("allowed: verlet, symplectic-euler, euler, midpoint, rk4, "
+                              "leapfrog, velocity-verlet, tc-verlet, verlet-lagged")));
+}
+
+TEST(SceneError, NodeOutsideTheGrid) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[0, 0], [10, 3]]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].nodes[1]'"),
+                                    HasSubstr("node [10, 3] is outside the 10x12 grid"),
+                                    HasSubstr("k must be in 0 .. 9, l in 0 .. 11")));
+}
+
+TEST(SceneError, NodeListedTwice) {
+  SceneText text;
+  text.tail = "[[load]]\nnodes = [[1, 1], [1, 1]]\nforce = [0, 1, 0]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'load[0].nodes[1]'"), HasSubstr("listed twice")));
+}
+
+TEST(SceneError, StartAfterEnd) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[0, 0]]\nstart = 10\nend = 9\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'fix[0].end'"), HasSubstr("must be >= start (10), got 9")));
+}
+
+TEST(SceneError, NegativeStart) {
+  SceneText text;
+  text.tail = "[[load]]\nnodes = [[0, 0]]\nforce = [1, 0, 0]\nstart = -1\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'load[0].start'"), HasSubstr("must be >= 0")));
+}
+
+TEST(SceneError, FixWithNoAxes) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[0, 0]]\naxes = \"\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].axes'"), HasSubstr("a fix with no axes"),
+                                    HasSubstr("give any of x, y, z")));
+}
+
+TEST(SceneError, UnknownAxis) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[0, 0]]\naxes = \"xw\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].axes'"), HasSubstr("unknown axis 'w'"),
+                                    HasSubstr("allowed letters: x, y, z")));
+}
+
+TEST(SceneError, FixWithoutNodes) {
+  SceneText text;
+  text.tail = "[[fix]]\naxes = \"y\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].nodes'"), HasSubstr("required"),
+                                    HasSubstr("or a region")));
+}
+
+TEST(SceneError, FixWithNodesAndRegion) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[0, 0]]\nregion = { row = 0 }\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'fix[0].region'"), HasSubstr("give nodes or region, not both")));
+}
+
+TEST(SceneError, FixAsATableInsteadOfBlocks) {
+  SceneText text;
+  text.tail = "[fix]\nnodes = [[0, 0]]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix'"), HasSubstr("must be [[fix]] blocks")));
+}
+
+TEST(SceneError, LoadWithoutForce) {
+  SceneText text;
+  text.tail = "[[load]]\nnodes = [[0, 0]]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'load[0].force'"),
+                                    HasSubstr("required: an array of 3 numbers")));
+}
+
+TEST(SceneError, BothMassAndDensity) {
+  SceneText text;
+  text.material += "density = 0.1\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'material.density'"), HasSubstr("not both")));
+}
+
+TEST(SceneError, NeitherMassNorDensity) {
+  SceneText text;
+  text.material = "zeta = 100.0\nxi = 0.3\nphi = 0.001\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'material.mass'"), HasSubstr("mass (total kg) or density")));
+}
+
+TEST(SceneError, TensorMissingWithoutPreset) {
+  SceneText text;
+  text.material = "mass = 1\nzeta = 100.0\nphi = 0.001\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'material.xi'"),
+                                    HasSubstr("required: a number or an array of 3")));
+}
+
+TEST(SceneError, TensorEntryOutOfRange) {
+  SceneText text;
+  text.material = "mass = 1\nzeta = [100, 0, 100]\nxi = 0.3\nphi = 0.001\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'material.zeta'"), HasSubstr("every entry must be > 0")));
+  text.material = "mass = 1\nzeta = 100\nxi = -0.3\nphi = 0.001\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'material.xi'"), HasSubstr("every entry must be >= 0")));
+}
+
+TEST(SceneError, MassNotPositive) {
+  SceneText text;
+  text.material = "mass = 0\nzeta = 100\nxi = 0.3\nphi = 0.001\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'material.mass'"), HasSubstr("must be > 0, got 0")));
+}
+
+TEST(SceneError, UnknownPreset) {
+  SceneText text;
+  text.material = "preset = \"tweed\"\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'material.preset'"), HasSubstr("unknown preset \"tweed\""),
+                    HasSubstr("allowed: silk, cotton, denim")));
+}
+
+TEST(SceneError, UnknownModelAndBorders) {
+  SceneText text;
+  text.tail = "[model]\nkind = \"mass-spring\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.kind'"), HasSubstr("allowed: cosserat")));
+  text.tail = "[model]\nborders = \"clamped\"\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'model.borders'"), HasSubstr("allowed: symmetric, published")));
+}
+
+TEST(SceneError, NegativeDampingAndViscosity) {
+  SceneText text;
+  text.tail = "[environment]\ndamping = -0.2\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'environment.damping'"), HasSubstr("must be >= 0")));
+  text.tail = "[environment.fluid]\nviscosity = -1\nvelocity = [1, 0, 0]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'environment.fluid.viscosity'"), HasSubstr("must be >= 0")));
+}
+
+TEST(SceneError, FluidWithoutVelocity) {
+  SceneText text;
+  text.tail = "[environment.fluid]\nviscosity = 1\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'environment.fluid.velocity'"), HasSubstr("required")));
+}
+
+TEST(SceneError, RegionWithTwoShapes) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { row = 0, column = 0 }\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'fix[0].region'"), HasSubstr("give exactly one of rect")));
+}
+
+TEST(SceneError, RectCornersOutOfOrder) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { rect = [3, 0, 1, 2] }\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].region.rect'"),
+                                    HasSubstr("needs k0 <= k1 and l0 <= l1")));
+}
+
+TEST(SceneError, RectOutsideTheGrid) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { rect = [0, 0, 1, 12] }\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].region.rect[3]'"),
+                                    HasSubstr("l1 = 12 is outside the grid: must be in 0 .. 11")));
+}
+
+TEST(SceneError, RowOutsideTheGrid) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { row = 12 }\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'fix[0].region.row'"), HasSubstr("must be in 0 .. 11")));
+}
+
+TEST(SceneError, DiskThatSelectsNoNode) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { disk = { center = [4.5, 4.5], radius = 0.5 } }\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'fix[0].region.disk'"), HasSubstr("selects no node")));
+}
+
+TEST(SceneError, DiskCentreOutsideTheGrid) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { disk = { center = [-1, 4], radius = 3 } }\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].region.disk.center'"),
+                                    HasSubstr("center [-1, 4] is outside the 10x12 grid")));
+}
+
+TEST(SceneError, DiskWithoutRadius) {
+  SceneText text;
+  text.tail = "[[fix]]\nregion = { disk = { center = [4, 4] } }\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].region.disk.radius'"),
+                                    HasSubstr("required: a number >= 0")));
+}
+
+TEST(SceneError, UnreadableFileIsNamed) {
+  try {
+    load_scene("no/such/scene.toml");
+    ADD_FAILURE() << "expected a SceneError";
+  } catch (const SceneError& error) {
+    EXPECT_THAT(error.what(), AllOf(StartsWith("no/such/scene.toml"), HasSubstr("cannot read")));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The shipped scenes
+
+std::vector<std::filesystem::path> shipped_scenes() {
+  std::vector<std::filesystem::path> paths;
+  for (const auto& entry : std::filesystem::directory_iterator(COSSERAT_SOURCE_DIR "/scenes")) {
+    if (entry.path().extension() == ".toml") paths.push_back(entry.path());
+  }
+  return paths;
+}
+
+TEST(ShippedScenes, LoadWithoutWarnings) {
+  const auto paths = shipped_scenes();
+  EXPECT_GE(paths.size(), 6u);
+  for (const auto& path : paths) {
+    SCOPED_TRACE(path.string());
+    const Scene scene = load_scene(path.string());
+    EXPECT_EQ(scene.name, path.stem().string());
+    EXPECT_TRUE(scene.warnings.empty());
+  }
+}
+
+TEST(ShippedScenes, CompressionLoadsAreTwentyHOneHTwoNewtons) {
+  const Scene scene = load_scene(COSSERAT_SOURCE_DIR "/scenes/s6_compression.toml");
+  ASSERT_EQ(scene.loads.size(), 40u);
+  const double area = scene.h1() * scene.h2();
+  for (const auto& load : scene.loads) {
+    const double per_area = load.start == 0 ? 20.0 : 5.0;
+    EXPECT_EQ(load.force.y, 0.0);
+    EXPECT_NEAR(std::abs(load.force.x), per_area * area, 1e-15);
+    EXPECT_NEAR(std::abs(load.force.z), per_area * area, 1e-15);
+  }
+}
+
+}  // namespace
+}  // namespace cosserat
