@@ -103,7 +103,7 @@ struct Scene {
   Integrator integrator = Integrator::verlet;
   double dt = 0.0;
   long steps = 0;
-  long output_every = 0;  // 0: only the first and the last frame
+  long output_every = 1;  // write a frame every N steps (the last step always)
 
   std::vector<Fix> fixes;
   std::vector<Load> loads;
