@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Node-steps per second of one Verlet step (bench_step) on 256², 1024², 2048² with 1 and 2
+# threads, into benchmarks/results/throughput-<host>-<date>.{json,md} with the machine,
+# compiler, git revision, ranks x threads and date beside every number.
+#   benchmarks/run_throughput.sh [extra Google Benchmark flags]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cmake --preset benchmark >/dev/null
+cmake --build --preset benchmark --target bench_step -j "$(nproc)" >/dev/null
+
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_PROC_BIND=close
+date=$(date -u +%Y-%m-%d)
+host=$(hostname -s)
+stem=benchmarks/results/throughput-$host-$date
+cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
+compiler=$(c++ --version | head -1)
+revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+
+build/benchmark/benchmarks/bench_step --benchmark_min_time=2 --benchmark_repetitions=3 \
+  --benchmark_report_aggregates_only=true \
+  --benchmark_context=cpu="$cpu" --benchmark_context=compiler="$compiler" \
+  --benchmark_context=flags="-O3 -march=native" --benchmark_context=git="$revision" \
+  --benchmark_context=ranks=1 \
+  --benchmark_out="$stem.json" --benchmark_out_format=json "$@"
+
+/usr/bin/python3 - "$stem" "$cpu" "$compiler" "$revision" "$date" <<'PY'
+import json, sys
+stem, cpu, compiler, revision, date = sys.argv[1:]
+runs = [b for b in json.load(open(stem + ".json"))["benchmarks"] if b.get("aggregate_name") == "median"]
+rate = {(int(b["name"].split("nodes:")[1].split("/")[0]), int(b["threads"])): b["items_per_second"] for b in runs}
+lines = [f"# Verlet step throughput, {date}", "",
+         f"Machine: {cpu}; compiler: {compiler}, -O3 -march=native; git {revision}; 1 rank.",
+         "Median of 3 repetitions of at least 2 s each (`benchmarks/run_throughput.sh`).", "",
+         "| grid | threads | node-steps/s | speed-up over 1 thread |", "|---|---|---|---|"]
+for (nodes, threads), r in sorted(rate.items()):
+    lines.append(f"| {nodes}² | {threads} | {r:.3e} | {r / rate[(nodes, 1)]:.2f} |")
+open(stem + ".md", "w").write("\n".join(lines) + "\n")
+print("\n".join(lines))
+PY
