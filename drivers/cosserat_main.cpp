@@ -194,7 +194,8 @@ int main(int argc, char** argv) {
       ->required();
   run_command->add_option("--set", options.overrides,
                           "Override a scene key: dotted.key=value, the value read as TOML "
-                          "(e.g. --set time.dt=5e-4 --set grid.nodes=[64,64]); repeatable");
+                          "(e.g. --set time.dt=5e-4 --set grid.nodes=[64,64]); repeatable")
+      ->allow_extra_args(false);
   run_command->add_option("-o,--output", options.output,
                           "HDF5 output file (default: <scene file stem>.h5 in the working "
                           "directory); the XDMF file goes beside it");
@@ -203,6 +204,9 @@ int main(int argc, char** argv) {
   run_command->add_flag("-q,--quiet", options.quiet,
                         "Print nothing but warnings and errors (the progress line is shown "
                         "only on a terminal anyway)");
+  run_command->footer(
+      "Threads: OMP_NUM_THREADS (default: all cores). On a terminal a progress line shows the "
+      "step, simulated time, steps/s and ETA. This version runs on one MPI rank.");
   app.footer(
       "Exit status: 0 ok, 2 bad input (nothing was run), 3 the run became unstable (frames so "
       "far and the last good state are kept), 1 anything else.");

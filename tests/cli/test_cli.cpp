@@ -156,6 +156,14 @@ TEST_F(Cli, SuccessfulRunWritesFramesAndSummary) {
     EXPECT_THAT(json.str(), HasSubstr(key));
 }
 
+TEST_F(Cli, OverridesMayComeBeforeTheScene) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = cosserat("run --set time.steps=100 --set time.output_every=25 " + scene +
+                            " -o " + path("o.h5"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(read_frames(path("o.h5")).first, 5);  // steps 0, 25, 50, 75, 100
+}
+
 // A step far above the stability limit: the monitor stops the run with status 3, names the
 // step and node, and the file keeps the frames written so far plus the last good state.
 TEST_F(Cli, BlowUpStopsWithItsOwnStatusAndKeepsWork) {
