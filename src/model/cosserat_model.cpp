@@ -155,15 +155,25 @@ void CosseratModel::compute_resultants(const Field<Vec3>& R, int k, int l) {
   out.christoffel_trace2 = trace2;
 }
 
+// D⁻ of the twisting moment M^{12} on the near border (B1 or B2), where the cell before p is
+// missing. The symmetric rules extend §2.3 rule 1 there: the missing cell carries no twisting
+// moment, so D⁻ M = (M[p] − 0)/h. MODEL.md §2.2's D⁺ instead (kept for "published") makes the
+// rest-state Jacobian non-symmetric along B1 and B2 (3e-3 relative on a 12 x 12 sheet, against
+// 2e-6 with this rule; docs/model.md).
+double CosseratModel::near_border_difference(double M_here, double M_next, double h) const {
+  return symmetric_borders_ ? M_here / h : (M_next - M_here) / h;
+}
+
 // Traction on the 1-face, T^1 = N^{11} a_1 + N^{21} a_2 + N^{31} n, with the transverse shear
-// N^{31} = D⁺_1 M^{11} + D⁻_2 M^{12} + Γ·M (§2.2; one-sided the other way at the border).
+// N^{31} = D⁺_1 M^{11} + D⁻_2 M^{12} + Γ·M (§2.2; D⁻_1 on the far border, and the near border
+// as near_border_difference says).
 Vec3 CosseratModel::traction1(int k, int l) const {
   const Block& b = *block_;
   const NodeResultants& p = resultants_(k, l);
   const double dM11 = k < b.m - 1 ? (resultants_(k + 1, l).M11 - p.M11) / h1_
                                   : (p.M11 - resultants_(k - 1, l).M11) / h1_;
   const double dM12 = l > 0 ? (p.M12 - resultants_(k, l - 1).M12) / h2_
-                            : (resultants_(k, l + 1).M12 - p.M12) / h2_;
+                            : near_border_difference(p.M12, resultants_(k, l + 1).M12, h2_);
   const double N31 = dM11 + dM12 + p.shear_christoffel1;
   return p.N11 * p.a1 + p.N21 * p.a2 + N31 * p.normal;
 }
@@ -175,7 +185,7 @@ Vec3 CosseratModel::traction2(int k, int l) const {
   const double dM22 = l < b.n - 1 ? (resultants_(k, l + 1).M22 - p.M22) / h2_
                                   : (p.M22 - resultants_(k, l - 1).M22) / h2_;
   const double dM21 = k > 0 ? (p.M12 - resultants_(k - 1, l).M12) / h1_
-                            : (resultants_(k + 1, l).M12 - p.M12) / h1_;
+                            : near_border_difference(p.M12, resultants_(k + 1, l).M12, h1_);
   const double N32 = dM22 + dM21 + p.shear_christoffel2;
   return p.N12 * p.a1 + p.N22 * p.a2 + N32 * p.normal;
 }

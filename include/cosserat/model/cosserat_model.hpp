@@ -46,6 +46,7 @@ class CosseratModel {
 
  private:
   void compute_resultants(const Field<Vec3>& r, int k, int l);
+  double near_border_difference(double M_here, double M_next, double h) const;
   Vec3 traction1(int k, int l) const;
   Vec3 traction2(int k, int l) const;
 
