@@ -164,6 +164,16 @@ double CosseratModel::near_border_difference(double M_here, double M_next, doubl
   return symmetric_borders_ ? M_here / h : (M_next - M_here) / h;
 }
 
+// The Γ·M part of the transverse shear on the face between p and p + e_a. Both derivative
+// terms of N^{3a} are centred on that face (D⁺_a M^{aa} between the nodes, D⁻_b M^{ab} between
+// two cells), so the symmetric rules put Γ·M there too, as the mean of the two nodes. Taken at
+// p alone (MODEL.md §2.2, kept for "published") it lets a sheet folded sharply over a held
+// line blow up whatever the step (docs/model.md, "Known limits": 9 of 23 such runs, against
+// 1 of 23 with the face value).
+double CosseratModel::on_face(double at_node, double at_next_node) const {
+  return symmetric_borders_ ? 0.5 * (at_node + at_next_node) : at_node;
+}
+
 // Traction on the 1-face, T^1 = N^{11} a_1 + N^{21} a_2 + N^{31} n, with the transverse shear
 // N^{31} = D⁺_1 M^{11} + D⁻_2 M^{12} + Γ·M (§2.2; D⁻_1 on the far border, and the near border
 // as near_border_difference says).
@@ -174,7 +184,10 @@ Vec3 CosseratModel::traction1(int k, int l) const {
                                   : (p.M11 - resultants_(k - 1, l).M11) / h1_;
   const double dM12 = l > 0 ? (p.M12 - resultants_(k, l - 1).M12) / h2_
                             : near_border_difference(p.M12, resultants_(k, l + 1).M12, h2_);
-  const double N31 = dM11 + dM12 + p.shear_christoffel1;
+  const double christoffel =
+      k < b.m - 1 ? on_face(p.shear_christoffel1, resultants_(k + 1, l).shear_christoffel1)
+                  : p.shear_christoffel1;
+  const double N31 = dM11 + dM12 + christoffel;
   return p.N11 * p.a1 + p.N21 * p.a2 + N31 * p.normal;
 }
 
@@ -186,7 +199,10 @@ Vec3 CosseratModel::traction2(int k, int l) const {
                                   : (p.M22 - resultants_(k, l - 1).M22) / h2_;
   const double dM21 = k > 0 ? (p.M12 - resultants_(k - 1, l).M12) / h1_
                             : near_border_difference(p.M12, resultants_(k + 1, l).M12, h1_);
-  const double N32 = dM22 + dM21 + p.shear_christoffel2;
+  const double christoffel =
+      l < b.n - 1 ? on_face(p.shear_christoffel2, resultants_(k, l + 1).shear_christoffel2)
+                  : p.shear_christoffel2;
+  const double N32 = dM22 + dM21 + christoffel;
   return p.N12 * p.a1 + p.N22 * p.a2 + N32 * p.normal;
 }
 

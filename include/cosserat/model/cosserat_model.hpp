@@ -47,6 +47,7 @@ class CosseratModel {
  private:
   void compute_resultants(const Field<Vec3>& r, int k, int l);
   double near_border_difference(double M_here, double M_next, double h) const;
+  double on_face(double at_node, double at_next_node) const;
   Vec3 traction1(int k, int l) const;
   Vec3 traction2(int k, int l) const;
 
