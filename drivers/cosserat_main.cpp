@@ -92,6 +92,17 @@ int run(const RunOptions& options, int rank, int ranks) {
     return kExitBadInput;
   }
 
+  const double needed = Simulation::memory_bytes(scene);
+  const double available = static_cast<double>(sysconf(_SC_PHYS_PAGES)) * sysconf(_SC_PAGE_SIZE);
+  if (needed > available) {
+    if (rank == 0)
+      fmt::print(stderr,
+                 "error: {}: a {} x {} grid needs about {:.1f} GiB, more than this machine's "
+                 "{:.1f} GiB\n",
+                 scene.path, scene.m, scene.n, needed / (1 << 30), available / (1 << 30));
+    return kExitBadInput;
+  }
+
   const std::string output = options.output.empty() ? default_output(scene) : options.output;
   std::unique_ptr<FrameWriter> writer;
   try {

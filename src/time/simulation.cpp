@@ -48,6 +48,14 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm)
       stepper_(scene, block_, dynamics_, rest_positions(scene, block_),
                initial_velocities(scene, block_)) {}
 
+double Simulation::memory_bytes(const Scene& scene) {
+  const double ghosted_nodes = (scene.m + 2.0 * kGhostWidth) * (scene.n + 2.0 * kGhostWidth);
+  // rk4 keeps eight position-sized fields (state, new state, acceleration, four stages).
+  const double per_node = sizeof(NodeResultants) + 2 * sizeof(Vec3) + 8 * sizeof(Vec3);
+  const double output_buffer = 3.0 * sizeof(double) * scene.m * scene.n;
+  return ghosted_nodes * per_node + output_buffer;
+}
+
 Diagnostics Simulation::diagnostics() {
   const Block& b = block_;
   const Field<Vec3>& r = stepper_.positions();

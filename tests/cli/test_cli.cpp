@@ -123,6 +123,14 @@ TEST_F(Cli, UnwritableOutputIsBadInput) {
   EXPECT_THAT(r.output, HasSubstr("out.h5"));
 }
 
+TEST_F(Cli, GridTooLargeForTheMachineIsBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = cosserat("run " + scene + " --set grid.nodes=[200000,200000] -o " + path("big.h5"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.output, HasSubstr("200000 x 200000 grid needs about"));
+  EXPECT_FALSE(fs::exists(path("big.h5")));
+}
+
 // Frames of an output file and whether every stored position is finite.
 std::pair<long, bool> read_frames(const std::string& file) {
   const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);

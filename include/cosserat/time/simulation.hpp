@@ -26,6 +26,10 @@ class Simulation {
  public:
   Simulation(const Scene& scene, MPI_Comm comm);
   Simulation(const Simulation&) = delete;
+
+  // Upper bound of the memory a run of `scene` takes on one rank: every field of the most
+  // demanding scheme, the force kernel's intermediates and the output buffer.
+  static double memory_bytes(const Scene& scene);
   Simulation& operator=(const Simulation&) = delete;
 
   std::optional<Instability> step() { return stepper_.step(); }
