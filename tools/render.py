@@ -50,7 +50,7 @@ def parse_arguments(argv):
     parser.add_argument("--output", type=Path,
                         help="PNG to write (default: the .h5 path with suffix .png)")
     parser.add_argument("--elev", type=float, default=20.0, help="camera elevation, degrees")
-    parser.add_argument("--azim", type=float, default=-60.0, help="camera azimuth, degrees")
+    parser.add_argument("--azim", type=float, default=-35.0, help="camera azimuth, degrees")
     parser.add_argument("--title", help="title (default: scene title, integrator and time)")
     parser.add_argument("--mesh", action="store_true", help="draw thin grid lines")
     return parser.parse_args(argv)
@@ -109,7 +109,7 @@ def facet_colours(x, y, z, light):
     lengths = np.linalg.norm(normals, axis=-1, keepdims=True)
     normals = np.divide(normals, lengths, out=np.zeros_like(normals), where=lengths > 0)
     lambert = np.abs(normals @ light.direction)
-    shade = 0.35 + 0.65 * lambert
+    shade = 0.5 + 0.5 * lambert
     colours = np.ones(x.shape + (4,))
     colours[:-1, :-1, :3] = np.asarray(to_rgba(CLOTH_COLOUR)[:3]) * shade[..., None]
     return colours
