@@ -1,7 +1,10 @@
 #pragma once
 // Scenes built in code for tests: a flat sheet with the SCENES.md defaults, to be varied.
 
+#include <gtest/gtest.h>
+
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "cosserat/scene/scene.hpp"
@@ -42,7 +45,13 @@ inline Fix fix_column(int k, int n) {
   return f;
 }
 
-inline double distance(const Vec3& a, const Vec3& b) { return norm(a - b); }
+// GoogleTest parameter name of a scheme: its scene name with '_' for '-'.
+inline std::string scheme_test_name(const ::testing::TestParamInfo<Integrator>& info) {
+  std::string name = integrator_name(info.param);
+  for (char& c : name)
+    if (c == '-') c = '_';
+  return name;
+}
 
 // Runs `steps` steps; fails the test (returns false) on instability.
 inline bool advance(Simulation& sim, long steps) {

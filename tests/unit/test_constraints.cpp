@@ -77,12 +77,7 @@ INSTANTIATE_TEST_SUITE_P(Constraints, Schemes,
                          ::testing::Values(Integrator::verlet, Integrator::leapfrog,
                                            Integrator::rk4, Integrator::velocity_verlet,
                                            Integrator::symplectic_euler),
-                         [](const auto& info) {
-                           std::string name = integrator_name(info.param);
-                           for (char& c : name)
-                             if (c == '-') c = '_';
-                           return name;
-                         });
+                         testing::scheme_test_name);
 
 }  // namespace
 }  // namespace cosserat

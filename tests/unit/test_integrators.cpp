@@ -14,13 +14,6 @@ using testing::flat_sheet;
 
 class EveryScheme : public ::testing::TestWithParam<Integrator> {};
 
-std::string scheme_test_name(const ::testing::TestParamInfo<Integrator>& info) {
-  std::string name = integrator_name(info.param);
-  for (char& c : name)
-    if (c == '-') c = '_';
-  return name;
-}
-
 // §5.2: gravity only, no constraints: every node follows r0 + v0 t + ½ g t². Schemes exact for
 // a constant acceleration reproduce it to round-off; the two Euler schemes carry their known
 // first-order bias ∓½ g Δt t, which is asserted exactly as well.
@@ -107,7 +100,7 @@ INSTANTIATE_TEST_SUITE_P(Integrators, EveryScheme,
                                            Integrator::rk4, Integrator::leapfrog,
                                            Integrator::velocity_verlet, Integrator::tc_verlet,
                                            Integrator::verlet_lagged),
-                         scheme_test_name);
+                         testing::scheme_test_name);
 
 }  // namespace
 }  // namespace cosserat
