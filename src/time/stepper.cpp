@@ -32,8 +32,7 @@ bool is_verlet_family(Integrator s) {
 
 Stepper::Stepper(const Scene& scene, const Block& block, Dynamics& dynamics,
                  const Field<Vec3>& positions, const Field<Vec3>& velocities)
-    : scene_(&scene),
-      block_(&block),
+    : block_(&block),
       dynamics_(&dynamics),
       constraints_(scene.fixes, block),
       scheme_(scene.integrator),

@@ -30,7 +30,6 @@ struct Block {
 
   int owned_k() const { return k1 - k0; }
   int owned_l() const { return l1 - l0; }
-  long owned_nodes() const { return static_cast<long>(owned_k()) * owned_l(); }
   int stride() const { return owned_k() + 2 * ghost; }
   std::size_t local_size() const {
     return static_cast<std::size_t>(stride()) * (owned_l() + 2 * ghost);

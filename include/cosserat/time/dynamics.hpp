@@ -34,7 +34,6 @@ class Dynamics {
 
   bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
   double rest_area() const { return rest_area_; }
-  double mass() const { return mass_; }
   double total_area(const Field<Vec3>& r) const;  // S, a global reduction
 
  private:

@@ -38,7 +38,6 @@ class Simulation {
   const Block& block() const { return block_; }
   const Field<Vec3>& positions() const { return stepper_.positions(); }
   const Field<Vec3>& velocities() { return stepper_.velocities(); }
-  Dynamics& dynamics() { return dynamics_; }
 
   Diagnostics diagnostics();
 

@@ -48,7 +48,6 @@ class Stepper {
   std::optional<Instability> check(const Field<Vec3>& next) const;
   void hold(Field<Vec3>& r, Field<Vec3>& v) const;
 
-  const Scene* scene_;
   const Block* block_;
   Dynamics* dynamics_;
   Constraints constraints_;
