@@ -1,57 +1,22 @@
 #include "cosserat/io/frame_writer.hpp"
 
-#include <hdf5.h>
-
 #include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <span>
 #include <stdexcept>
-#include <utility>
 
 #include <fmt/format.h>
 
 #include "cosserat/io/xdmf.hpp"
+#include "hdf5_file.hpp"
 
 namespace cosserat {
+
+using hdf5::Handle;
+
 namespace {
-
-// An HDF5 identifier that closes itself. Each kind of id has its own close function, so the
-// handle carries it.
-class Handle {
- public:
-  using Close = herr_t (*)(hid_t);
-
-  Handle(hid_t id, Close close) : id_(id), close_(close) {}
-  ~Handle() {
-    if (id_ >= 0) close_(id_);
-  }
-  Handle(const Handle&) = delete;
-  Handle& operator=(const Handle&) = delete;
-  Handle(Handle&& other) noexcept
-      : id_(std::exchange(other.id_, H5I_INVALID_HID)), close_(other.close_) {}
-  Handle& operator=(Handle&&) = delete;
-
-  hid_t get() const { return id_; }
-
- private:
-  hid_t id_;
-  Close close_;
-};
-
-herr_t keep_innermost(unsigned depth, const H5E_error2_t* error, void* description) {
-  if (depth == 0 && error->desc != nullptr) *static_cast<std::string*>(description) = error->desc;
-  return 0;
-}
-
-// The most specific message on HDF5's error stack (walking upward starts where the error was
-// detected), e.g. the operating system's reason a file could not be created.
-std::string innermost_hdf5_error() {
-  std::string description = "no detail from HDF5";
-  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, keep_innermost, &description);
-  return description;
-}
 
 // HDF5 refuses chunks of 4 GiB or more. One frame is one chunk, so that appending a frame
 // touches one chunk, unless the frame is that large; then it is split into bands of rows k
@@ -72,122 +37,6 @@ std::array<hsize_t, 3> node_shape(int m, int n) {
   return {static_cast<hsize_t>(m), static_cast<hsize_t>(n), 3};
 }
 
-}  // namespace
-
-// Everything that speaks HDF5. Members close in reverse order: datasets before the file.
-struct FrameWriter::Hdf5Output {
-  std::string path;
-  Handle file;
-  Handle positions;
-  Handle time;
-  Handle step;
-
-  Hdf5Output(const std::string& h5_path, int m, int n);
-
-  [[noreturn]] void fail(const std::string& operation) const {
-    throw std::runtime_error(
-        fmt::format("HDF5 file '{}': {} failed: {}", path, operation, innermost_hdf5_error()));
-  }
-  hid_t check(hid_t id, const std::string& operation) const {
-    if (id < 0) fail(operation);
-    return id;
-  }
-  Handle open(hid_t id, Handle::Close close, const std::string& operation) const {
-    return Handle(check(id, operation), close);
-  }
-
-  Handle create_file() const;
-  Handle create_series(const char* name, hid_t file_type, std::span<const hsize_t> frame_shape,
-                       std::span<const hsize_t> chunk) const;
-  void append(const Handle& dataset, const char* name, hsize_t frame,
-              std::span<const hsize_t> frame_shape, hid_t memory_type, const void* values) const;
-  void write_string_attribute(const std::string& name, const std::string& value) const;
-  void flush() const { check(H5Fflush(file.get(), H5F_SCOPE_GLOBAL), "flush"); }
-};
-
-FrameWriter::Hdf5Output::Hdf5Output(const std::string& h5_path, int m, int n)
-    : path(h5_path),
-      file(create_file()),
-      positions(create_series("/positions", H5T_IEEE_F64LE, node_shape(m, n),
-                              positions_chunk(m, n))),
-      time(create_series("/time", H5T_IEEE_F64LE, {}, series_chunk)),
-      step(create_series("/step", H5T_STD_I64LE, {}, series_chunk)) {}
-
-Handle FrameWriter::Hdf5Output::create_file() const {
-  const Handle access = open(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create file access list");
-  // The 1.10 format's superblock carries an "open for writing" flag that makes the file of a
-  // killed run refuse to open until h5clear is run on it; capping the format at 1.8 keeps that
-  // flag out (and the file readable by any HDF5 since 2008).
-  check(H5Pset_libver_bounds(access.get(), H5F_LIBVER_EARLIEST, H5F_LIBVER_V18),
-        "set format bounds");
-  return open(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, access.get()), H5Fclose,
-              "create file");
-}
-
-// A dataset of frames: the first dimension is unlimited and grows by one per written frame.
-Handle FrameWriter::Hdf5Output::create_series(const char* name, hid_t file_type,
-                                              std::span<const hsize_t> frame_shape,
-                                              std::span<const hsize_t> chunk) const {
-  std::array<hsize_t, 4> dims{0, 0, 0, 0};
-  std::array<hsize_t, 4> max_dims{H5S_UNLIMITED, 0, 0, 0};
-  std::ranges::copy(frame_shape, dims.begin() + 1);
-  std::ranges::copy(frame_shape, max_dims.begin() + 1);
-  const int rank = static_cast<int>(frame_shape.size()) + 1;
-  const std::string what = fmt::format("create dataset {}", name);
-
-  const Handle space = open(H5Screate_simple(rank, dims.data(), max_dims.data()), H5Sclose, what);
-  const Handle properties = open(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
-  check(H5Pset_chunk(properties.get(), rank, chunk.data()), what + " (chunk shape)");
-  return open(H5Dcreate2(file.get(), name, file_type, space.get(), H5P_DEFAULT, properties.get(),
-                         H5P_DEFAULT),
-              H5Dclose, what);
-}
-
-void FrameWriter::Hdf5Output::append(const Handle& dataset, const char* name, hsize_t frame,
-                                     std::span<const hsize_t> frame_shape, hid_t memory_type,
-                                     const void* values) const {
-  std::array<hsize_t, 4> extent{frame + 1, 0, 0, 0};
-  std::array<hsize_t, 4> start{frame, 0, 0, 0};
-  std::array<hsize_t, 4> count{1, 0, 0, 0};
-  std::ranges::copy(frame_shape, extent.begin() + 1);
-  std::ranges::copy(frame_shape, count.begin() + 1);
-  const int rank = static_cast<int>(frame_shape.size()) + 1;
-  const std::string what = fmt::format("write frame {} of {}", frame, name);
-
-  check(H5Dset_extent(dataset.get(), extent.data()), what + " (extend)");
-  const Handle file_space = open(H5Dget_space(dataset.get()), H5Sclose, what);
-  check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
-                            nullptr),
-        what + " (select)");
-  const Handle memory_space = open(H5Screate_simple(rank, count.data(), nullptr), H5Sclose, what);
-  check(H5Dwrite(dataset.get(), memory_type, memory_space.get(), file_space.get(), H5P_DEFAULT,
-                 values),
-        what);
-}
-
-// Variable-length UTF-8, which h5py reads back as str (fixed-length strings come back as bytes).
-// The text lives in the global heap, so a scene of any length fits; an attribute stored in the
-// object header is limited to 64 KiB.
-void FrameWriter::Hdf5Output::write_string_attribute(const std::string& name,
-                                                     const std::string& value) const {
-  const std::string what = fmt::format("write attribute '{}'", name);
-  const htri_t exists = H5Aexists(file.get(), name.c_str());
-  check(exists, what + " (look up)");
-  if (exists > 0) check(H5Adelete(file.get(), name.c_str()), what + " (delete old)");
-
-  const Handle type = open(H5Tcopy(H5T_C_S1), H5Tclose, what);
-  check(H5Tset_size(type.get(), H5T_VARIABLE), what + " (type)");
-  check(H5Tset_cset(type.get(), H5T_CSET_UTF8), what + " (type)");
-  const Handle space = open(H5Screate(H5S_SCALAR), H5Sclose, what);
-  const Handle attribute = open(
-      H5Acreate2(file.get(), name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
-      H5Aclose, what);
-  const char* text = value.c_str();
-  check(H5Awrite(attribute.get(), type.get(), &text), what);
-}
-
-namespace {
-
 std::string join_lines(const std::vector<std::string>& lines) {
   std::string joined;
   for (const std::string& line : lines) {
@@ -201,47 +50,166 @@ std::filesystem::path xmf_path_for(const std::string& h5_path) {
   return std::filesystem::path(h5_path).replace_extension(".xmf");
 }
 
+int rank_in(MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  return rank;
+}
+
+// A dataset of frames: the first dimension is unlimited and grows by one per written frame.
+Handle create_series(const hdf5::File& file, const char* name, hid_t file_type,
+                     std::span<const hsize_t> frame_shape, std::span<const hsize_t> chunk) {
+  std::array<hsize_t, 4> dims{0, 0, 0, 0};
+  std::array<hsize_t, 4> max_dims{H5S_UNLIMITED, 0, 0, 0};
+  std::ranges::copy(frame_shape, dims.begin() + 1);
+  std::ranges::copy(frame_shape, max_dims.begin() + 1);
+  const int rank = static_cast<int>(frame_shape.size()) + 1;
+  const std::string what = fmt::format("create dataset {}", name);
+
+  const Handle space =
+      file.open(H5Screate_simple(rank, dims.data(), max_dims.data()), H5Sclose, what);
+  const Handle properties = file.open(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
+  file.check(H5Pset_chunk(properties.get(), rank, chunk.data()), what + " (chunk shape)");
+  return file.open(H5Dcreate2(file.get(), name, file_type, space.get(), H5P_DEFAULT,
+                              properties.get(), H5P_DEFAULT),
+                   H5Dclose, what);
+}
+
+// Sets the number of frames of a series; collective.
+void resize_series(const hdf5::File& file, const Handle& dataset, hsize_t frames,
+                   const std::string& what) {
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  std::array<hsize_t, 4> extent{};
+  file.check(H5Sget_simple_extent_dims(space.get(), extent.data(), nullptr), what);
+  extent[0] = frames;
+  file.check(H5Dset_extent(dataset.get(), extent.data()), what + " (extent)");
+}
+
+// Writes one value of a one-dimensional series at `frame`: rank 0 writes, the others take part
+// in the collective call with an empty selection.
+void write_series_value(const hdf5::File& file, const Handle& dataset, hsize_t frame,
+                        hid_t memory_type, const void* value, bool writer,
+                        const std::string& what) {
+  const Handle file_space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  const hsize_t one = 1;
+  const Handle memory_space = file.open(H5Screate_simple(1, &one, nullptr), H5Sclose, what);
+  if (writer) {
+    file.check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &frame, nullptr, &one,
+                                   nullptr),
+               what + " (select)");
+  } else {
+    file.check(H5Sselect_none(file_space.get()), what + " (select)");
+    file.check(H5Sselect_none(memory_space.get()), what + " (select)");
+  }
+  file.check(H5Dwrite(dataset.get(), memory_type, memory_space.get(), file_space.get(),
+                      file.collective(), value),
+             what);
+}
+
+template <class T>
+std::vector<T> read_series(const hdf5::File& file, const Handle& dataset, hid_t memory_type,
+                           const std::string& what) {
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  hsize_t frames = 0;
+  file.check(H5Sget_simple_extent_dims(space.get(), &frames, nullptr), what);
+  std::vector<T> values(frames);
+  if (frames > 0)
+    file.check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, file.collective(),
+                       values.data()),
+               what);
+  return values;
+}
+
 }  // namespace
 
-FrameWriter::FrameWriter(const std::string& h5_path, int m, int n, const std::string& scene_text,
-                         const std::string& integrator, const std::string& version,
-                         const std::vector<std::string>& overrides)
-    : h5_path_(h5_path), xmf_path_(xmf_path_for(h5_path).string()), m_(m), n_(n) {
-  if (m < 1 || n < 1) {
-    throw std::runtime_error(
-        fmt::format("HDF5 file '{}': grid {} x {} has no nodes to write", h5_path, m, n));
+// Members close in reverse order: datasets before the file.
+struct FrameWriter::Datasets {
+  Handle positions;
+  Handle time;
+  Handle step;
+};
+
+FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
+                         const std::string& scene_text, const std::string& integrator,
+                         const std::string& version, const std::vector<std::string>& overrides)
+    : block_(&block),
+      h5_path_(h5_path),
+      xmf_path_(xmf_path_for(h5_path).string()),
+      rank_(rank_in(block.comm)) {
+  if (block.m < 1 || block.n < 1)
+    throw std::runtime_error(fmt::format("HDF5 file '{}': grid {} x {} has no nodes to write",
+                                         h5_path, block.m, block.n));
+  file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::create);
+  datasets_ = std::make_unique<Datasets>(Datasets{
+      create_series(*file_, "/positions", H5T_IEEE_F64LE, node_shape(block.m, block.n),
+                    positions_chunk(block.m, block.n)),
+      create_series(*file_, "/time", H5T_IEEE_F64LE, {}, series_chunk),
+      create_series(*file_, "/step", H5T_STD_I64LE, {}, series_chunk)});
+  file_->write_attribute("scene", scene_text);
+  file_->write_attribute("integrator", integrator);
+  file_->write_attribute("version", version);
+  file_->write_attribute("overrides", join_lines(overrides));
+  file_->flush();
+}
+
+FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step)
+    : block_(&block),
+      h5_path_(h5_path),
+      xmf_path_(xmf_path_for(h5_path).string()),
+      rank_(rank_in(block.comm)) {
+  file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::read_write);
+  const std::string what = "reopen for a restart";
+  auto open = [&](const char* name) {
+    return file_->open(H5Dopen2(file_->get(), name, H5P_DEFAULT), H5Dclose,
+                       fmt::format("{}: open {}", what, name));
+  };
+  datasets_ = std::make_unique<Datasets>(Datasets{open("/positions"), open("/time"), open("/step")});
+  const auto steps = read_series<std::int64_t>(*file_, datasets_->step, H5T_NATIVE_INT64, what);
+  const auto times = read_series<double>(*file_, datasets_->time, H5T_NATIVE_DOUBLE, what);
+  for (std::size_t f = 0; f < steps.size() && f < times.size() && steps[f] <= step; ++f) {
+    steps_.push_back(steps[f]);
+    times_.push_back(times[f]);
   }
-  // Failures become exceptions carrying HDF5's innermost message; the default handler would
-  // also print the whole stack to stderr, from every rank.
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  output_ = std::make_unique<Hdf5Output>(h5_path, m, n);
-  output_->write_string_attribute("scene", scene_text);
-  output_->write_string_attribute("integrator", integrator);
-  output_->write_string_attribute("version", version);
-  output_->write_string_attribute("overrides", join_lines(overrides));
-  output_->flush();
+  const auto kept = static_cast<hsize_t>(steps_.size());
+  resize_series(*file_, datasets_->positions, kept, what);
+  resize_series(*file_, datasets_->time, kept, what);
+  resize_series(*file_, datasets_->step, kept, what);
+  file_->write_attribute("status", std::string("running (restarted)"));
+  file_->flush();
+  write_xdmf_file();
 }
 
 FrameWriter::~FrameWriter() = default;
 
-void FrameWriter::write_frame(long step, double time, const double* positions) {
-  const auto frame = static_cast<hsize_t>(times_.size());
+void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positions) {
+  const auto frame = static_cast<hsize_t>(steps_.size());
+  const std::string what = fmt::format("write frame {}", frame);
   const std::int64_t step_value = step;
-  output_->append(output_->positions, "/positions", frame, node_shape(m_, n_), H5T_NATIVE_DOUBLE,
-                  positions);
-  output_->append(output_->time, "/time", frame, {}, H5T_NATIVE_DOUBLE, &time);
-  output_->append(output_->step, "/step", frame, {}, H5T_NATIVE_INT64, &step_value);
-  output_->flush();
+  resize_series(*file_, datasets_->positions, frame + 1, what);
+  resize_series(*file_, datasets_->time, frame + 1, what);
+  resize_series(*file_, datasets_->step, frame + 1, what);
+  const std::array<hsize_t, 1> at{frame};
+  file_->write_block(datasets_->positions.get(), positions, at, what + " of /positions");
+  write_series_value(*file_, datasets_->time, frame, H5T_NATIVE_DOUBLE, &time, rank_ == 0,
+                     what + " of /time");
+  write_series_value(*file_, datasets_->step, frame, H5T_NATIVE_INT64, &step_value, rank_ == 0,
+                     what + " of /step");
+  file_->flush();
 
   times_.push_back(time);
-  write_xdmf(xmf_path_, std::filesystem::path(h5_path_).filename().string(), m_, n_, times_);
+  steps_.push_back(step);
+  write_xdmf_file();
+}
+
+void FrameWriter::write_xdmf_file() const {
+  if (rank_ == 0)
+    write_xdmf(xmf_path_, std::filesystem::path(h5_path_).filename().string(), block_->m,
+               block_->n, times_);
 }
 
 void FrameWriter::set_attribute(const std::string& name, const std::string& value) {
-  output_->write_string_attribute(name, value);
-  output_->flush();
+  file_->write_attribute(name, value);
+  file_->flush();
 }
-
-long FrameWriter::frames() const { return static_cast<long>(times_.size()); }
 
 }  // namespace cosserat

@@ -45,6 +45,8 @@ std::string json_number(double value) {
 std::string to_json(const RunSummary& s) {
   const std::string unstable_step =
       s.unstable_step ? fmt::format("{}", *s.unstable_step) : "null";
+  const std::string restarted_from =
+      s.restarted_from ? fmt::format("{}", *s.restarted_from) : "null";
   const Vec3& com = s.center_of_mass;
   return fmt::format(
       R"({{
@@ -52,12 +54,15 @@ std::string to_json(const RunSummary& s) {
   "grid": [{}, {}],
   "ranks": {},
   "threads": {},
+  "split": [{}, {}],
   "integrator": {},
   "dt": {},
   "steps": {},
   "sim_time": {},
   "wall_seconds": {},
   "node_steps_per_second": {},
+  "halo_seconds": {},
+  "restarted_from": {},
   "status": {},
   "unstable_step": {},
   "area_ratio": {},
@@ -67,9 +72,10 @@ std::string to_json(const RunSummary& s) {
   "output": {}
 }}
 )",
-      json_string(s.scene), s.m, s.n, s.ranks, s.threads, json_string(s.integrator),
-      json_number(s.dt), s.steps, json_number(s.sim_time), json_number(s.wall_seconds),
-      json_number(s.node_steps_per_second), json_string(s.status), unstable_step,
+      json_string(s.scene), s.m, s.n, s.ranks, s.threads, s.parts_k, s.parts_l,
+      json_string(s.integrator), json_number(s.dt), s.steps, json_number(s.sim_time),
+      json_number(s.wall_seconds), json_number(s.node_steps_per_second),
+      json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,
       json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
       json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output));
 }

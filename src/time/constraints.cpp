@@ -49,4 +49,21 @@ void Constraints::hold_velocities(Field<Vec3>& velocities) const {
   }
 }
 
+std::vector<Constraints::NodeState> Constraints::state() const {
+  std::vector<NodeState> states;
+  states.reserve(nodes_.size());
+  for (const HeldNode& node : nodes_) states.push_back({node.k, node.l, node.held, node.value});
+  return states;
+}
+
+void Constraints::restore(const std::vector<NodeState>& states) {
+  std::map<std::pair<int, int>, const NodeState*> by_node;
+  for (const NodeState& s : states) by_node[{s.k, s.l}] = &s;
+  for (HeldNode& node : nodes_)
+    if (const auto found = by_node.find({node.k, node.l}); found != by_node.end()) {
+      node.held = found->second->held;
+      node.value = found->second->value;
+    }
+}
+
 }  // namespace cosserat

@@ -1,6 +1,6 @@
 #include "cosserat/time/dynamics.hpp"
 
-#include "cosserat/grid/reduce.hpp"
+#include <cmath>
 
 namespace cosserat {
 
@@ -9,6 +9,8 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
       model_(block, scene.h1(), scene.h2(),
              flat_rest_state(scene.material, scene.u, scene.v), scene.borders),
       h1h2_(scene.h1() * scene.h2()),
+      // 2⁻⁴⁰ of a grid cell: far below the round-off of a double sum over the cells.
+      area_quantum_(std::ldexp(h1h2_, -40)),
       mass_(scene.material.mass),
       rest_area_(total_area(rest_positions)),
       gravity_(scene.gravity),
@@ -25,7 +27,7 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
 }
 
 double Dynamics::total_area(const Field<Vec3>& r) const {
-  return global_sum(block_area(r), block_->comm);
+  return block_area(r, area_quantum_).global_total(block_->comm);
 }
 
 VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a) {

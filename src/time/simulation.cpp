@@ -2,24 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
 #include "cosserat/grid/reduce.hpp"
 
 namespace cosserat {
-
-namespace {
-
-Block single_block(const Scene& scene, MPI_Comm comm) {
-  int ranks = 1;
-  MPI_Comm_size(comm, &ranks);
-  if (ranks != 1)
-    throw std::runtime_error(
-        "this build runs on one MPI rank; subdomain decomposition is not implemented yet");
-  return Block::whole(scene.m, scene.n, comm);
-}
-
-}  // namespace
 
 Field<Vec3> Simulation::rest_positions(const Scene& scene, const Block& block) {
   Field<Vec3> r(block);
@@ -41,18 +27,39 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
   return v;
 }
 
+namespace {
+
+int rank_in(MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  return rank;
+}
+
+int size_of(MPI_Comm comm) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  return size;
+}
+
+}  // namespace
+
 Simulation::Simulation(const Scene& scene, MPI_Comm comm)
+    : Simulation(scene, comm, Decomposition::choose(scene.m, scene.n, size_of(comm))) {}
+
+Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& decomposition)
     : scene_(&scene),
-      block_(single_block(scene, comm)),
+      decomposition_(decomposition),
+      block_(decomposition_.block(rank_in(comm), comm)),
+      halo_(decomposition_, block_, rank_in(comm)),
       dynamics_(scene, block_, rest_positions(scene, block_)),
-      stepper_(scene, block_, dynamics_, rest_positions(scene, block_),
+      stepper_(scene, block_, halo_, dynamics_, rest_positions(scene, block_),
                initial_velocities(scene, block_)) {}
 
-double Simulation::memory_bytes(const Scene& scene) {
-  const double ghosted_nodes = (scene.m + 2.0 * kGhostWidth) * (scene.n + 2.0 * kGhostWidth);
+double Simulation::memory_bytes(const Block& block) {
+  const double ghosted_nodes = static_cast<double>(block.local_size());
   // rk4 keeps eight position-sized fields (state, new state, acceleration, four stages).
   const double per_node = sizeof(NodeResultants) + 2 * sizeof(Vec3) + 8 * sizeof(Vec3);
-  const double output_buffer = 3.0 * sizeof(double) * scene.m * scene.n;
+  const double output_buffer = 3.0 * sizeof(double) * block.owned_k() * block.owned_l();
   return ghosted_nodes * per_node + output_buffer;
 }
 
@@ -94,21 +101,6 @@ Diagnostics Simulation::diagnostics() {
   d.center_of_mass = Vec3{global_sum(sum.x, b.comm), global_sum(sum.y, b.comm),
                           global_sum(sum.z, b.comm)} / nodes;
   return d;
-}
-
-std::vector<double> Simulation::gather_positions() const {
-  const Block& b = block_;
-  const Field<Vec3>& r = stepper_.positions();
-  std::vector<double> out(static_cast<std::size_t>(b.m) * b.n * 3);
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) {
-      const std::size_t at = (static_cast<std::size_t>(k) * b.n + l) * 3;
-      const Vec3 p = r(k, l);
-      out[at] = p.x;
-      out[at + 1] = p.y;
-      out[at + 2] = p.z;
-    }
-  return out;
 }
 
 }  // namespace cosserat

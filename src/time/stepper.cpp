@@ -30,9 +30,10 @@ bool is_verlet_family(Integrator s) {
 
 }  // namespace
 
-Stepper::Stepper(const Scene& scene, const Block& block, Dynamics& dynamics,
+Stepper::Stepper(const Scene& scene, const Block& block, Halo& halo, Dynamics& dynamics,
                  const Field<Vec3>& positions, const Field<Vec3>& velocities)
     : block_(&block),
+      halo_(&halo),
       dynamics_(&dynamics),
       constraints_(scene.fixes, block),
       scheme_(scene.integrator),
@@ -57,6 +58,7 @@ void Stepper::start() {
   const Block& b = *block_;
   constraints_.begin_step(0, r_);
   hold(r_, v_);
+  halo_->exchange(r_);
   const double dt = dt_;
   switch (scheme_) {
     case Integrator::verlet:
@@ -141,6 +143,9 @@ std::optional<Instability> Stepper::step() {
       break;
   }
   r_.swap(r_next_);
+  // The accepted positions are where the next step's forces are read; velocity-verlet's were
+  // exchanged before its second force evaluation.
+  if (scheme_ != Integrator::velocity_verlet) halo_->exchange(r_);
   ++step_;
   time_ = static_cast<double>(step_) * dt_;
   return std::nullopt;
@@ -225,6 +230,7 @@ void Stepper::midpoint_step() {
     v_stage_(k, l) = v_(k, l) + (0.5 * dt) * a_(k, l);
   });
   hold(r_stage_, v_stage_);
+  halo_->exchange(r_stage_);
   dynamics_->acceleration(r_stage_, v_stage_, step_, a_);
   for_owned(*block_, [&](int k, int l) {
     r_next_(k, l) = r_(k, l) + dt * v_stage_(k, l);
@@ -245,6 +251,7 @@ void Stepper::rk4_step() {
   });
   hold(r_stage_, v_stage_);
   for (const double fraction : {0.5, 1.0}) {
+    halo_->exchange(r_stage_);
     dynamics_->acceleration(r_stage_, v_stage_, step_, a_);
     for_owned(*block_, [&](int k, int l) {
       const Vec3 vs = v_stage_(k, l), as = a_(k, l);
@@ -255,6 +262,7 @@ void Stepper::rk4_step() {
     });
     hold(r_stage_, v_stage_);
   }
+  halo_->exchange(r_stage_);
   dynamics_->acceleration(r_stage_, v_stage_, step_, a_);
   for_owned(*block_, [&](int k, int l) {
     r_next_(k, l) = r_(k, l) + (dt / 6.0) * (r_sum_(k, l) + v_stage_(k, l));
@@ -272,6 +280,7 @@ void Stepper::velocity_verlet_step() {
   });
   hold(r_next_, v_stage_);
   Field<Vec3>& a_next = r_sum_;
+  halo_->exchange(r_next_);
   dynamics_->acceleration(r_next_, v_stage_, step_ + 1, a_next);
   for_owned(*block_, [&](int k, int l) {
     v_sum_(k, l) = v_(k, l) + (0.5 * dt) * (a_(k, l) + a_next(k, l));
@@ -318,6 +327,24 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next) const {
   MPI_Allreduce(&reason, &any_reason, 1, MPI_INT, MPI_MAX, b.comm);
   return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, static_cast<int>(global % b.m),
                      static_cast<int>(global / b.m), any_reason != 0};
+}
+
+std::vector<Stepper::StateField> Stepper::state_fields() {
+  std::vector<StateField> fields{{"positions", &r_}};
+  if (is_verlet_family(scheme_)) {
+    fields.push_back({"previous_positions", &r_prev_});
+  } else {
+    fields.push_back({"velocities", &v_});
+    if (scheme_ == Integrator::velocity_verlet) fields.push_back({"accelerations", &a_});
+  }
+  return fields;
+}
+
+void Stepper::resume(long step) {
+  step_ = step;
+  time_ = static_cast<double>(step_) * dt_;
+  velocities_current_ = false;
+  halo_->exchange(r_);
 }
 
 const Field<Vec3>& Stepper::velocities() {

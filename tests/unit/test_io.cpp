@@ -100,6 +100,18 @@ std::vector<double> frame_positions(int m, int n, int frame) {
   return positions;
 }
 
+// The same values as a field on a block, which is what the writer takes.
+Field<Vec3> frame_field(const Block& block, int frame) {
+  const std::vector<double> values = frame_positions(block.m, block.n, frame);
+  Field<Vec3> field(block);
+  for (int k = 0; k < block.m; ++k)
+    for (int l = 0; l < block.n; ++l) {
+      const std::size_t at = 3 * (static_cast<std::size_t>(k) * block.n + l);
+      field(k, l) = Vec3{values[at], values[at + 1], values[at + 2]};
+    }
+  return field;
+}
+
 class FrameWriterTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -123,12 +135,13 @@ TEST_F(FrameWriterTest, RoundTripsFramesTimesStepsAndAttributes) {
   const std::vector<std::int64_t> steps{0, 100, 300};
   std::vector<double> expected;
 
-  FrameWriter writer(h5.string(), m, n, "[grid]\nnodes = [4, 5]\n", "verlet", "0.1.0",
+  const Block block = Block::whole(m, n, MPI_COMM_SELF);
+  FrameWriter writer(h5.string(), block, "[grid]\nnodes = [4, 5]\n", "verlet", "0.1.0",
                      {"time.dt=1e-4", "grid.nodes=[4,5]"});
   EXPECT_EQ(writer.frames(), 0);
   for (int frame = 0; frame < 3; ++frame) {
     const std::vector<double> positions = frame_positions(m, n, frame);
-    writer.write_frame(steps[frame], times[frame], positions.data());
+    writer.write_frame(steps[frame], times[frame], frame_field(block, frame));
     expected.insert(expected.end(), positions.begin(), positions.end());
     EXPECT_EQ(writer.frames(), frame + 1);
 
@@ -165,10 +178,9 @@ TEST_F(FrameWriterTest, RoundTripsFramesTimesStepsAndAttributes) {
 
 TEST_F(FrameWriterTest, XdmfNamesEveryFrameOfTheHdf5File) {
   const fs::path h5 = directory_ / "sheet.h5";
-  FrameWriter writer(h5.string(), 3, 2, "", "rk4", "0.1.0", {});
-  for (int frame = 0; frame < 3; ++frame) {
-    writer.write_frame(frame * 10, frame * 0.5, frame_positions(3, 2, frame).data());
-  }
+  const Block block = Block::whole(3, 2, MPI_COMM_SELF);
+  FrameWriter writer(h5.string(), block, "", "rk4", "0.1.0", {});
+  for (int frame = 0; frame < 3; ++frame) writer.write_frame(frame * 10, frame * 0.5, frame_field(block, frame));
 
   const std::string xmf = read_text(directory_ / "sheet.xmf");
   EXPECT_NE(xmf.find(R"(CollectionType="Temporal")"), std::string::npos);
@@ -185,7 +197,8 @@ TEST_F(FrameWriterTest, XdmfNamesEveryFrameOfTheHdf5File) {
 TEST_F(FrameWriterTest, StoresLongSceneTextAndEmptyOverrides) {
   const fs::path h5 = directory_ / "plain.h5";
   const std::string scene(100000, '#');
-  { FrameWriter writer(h5.string(), 2, 2, scene, "verlet", "0.1.0", {}); }
+  const Block block = Block::whole(2, 2, MPI_COMM_SELF);
+  { FrameWriter writer(h5.string(), block, scene, "verlet", "0.1.0", {}); }
   const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   ASSERT_TRUE(file.valid());
   EXPECT_EQ(read_string_attribute(file.get(), "scene"), scene);
@@ -197,7 +210,8 @@ TEST_F(FrameWriterTest, StoresLongSceneTextAndEmptyOverrides) {
 // writes no frame, so this costs nothing.
 TEST_F(FrameWriterTest, SplitsFramesLargerThanTheChunkLimit) {
   const fs::path h5 = directory_ / "large.h5";
-  { FrameWriter writer(h5.string(), 20000, 20000, "scene", "verlet", "0.1.0", {}); }
+  const Block block = Block::whole(20000, 20000, MPI_COMM_SELF);
+  { FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {}); }
   const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   const Hid dataset(H5Dopen2(file.get(), "/positions", H5P_DEFAULT), H5Dclose);
   const Hid properties(H5Dget_create_plist(dataset.get()), H5Pclose);
@@ -212,7 +226,8 @@ TEST_F(FrameWriterTest, SplitsFramesLargerThanTheChunkLimit) {
 TEST_F(FrameWriterTest, UnwritablePathNamesTheFile) {
   const std::string h5 = (directory_ / "missing" / "run.h5").string();
   try {
-    FrameWriter writer(h5, 2, 2, "scene", "verlet", "0.1.0", {});
+    const Block block = Block::whole(2, 2, MPI_COMM_SELF);
+    FrameWriter writer(h5, block, "scene", "verlet", "0.1.0", {});
     FAIL() << "created a file in a folder that does not exist";
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find(h5), std::string::npos) << error.what();
@@ -242,6 +257,7 @@ RunSummary example_summary() {
   return summary;
 }
 
+// DESIGN.md's keys, in its order, with the decomposition and halo time of issue 3 added.
 TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
   const std::string json = to_json(example_summary());
   const std::regex key(R"re(\n  "(\w+)":)re");
@@ -251,13 +267,15 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
     keys.push_back((*it)[1]);
   }
   const std::vector<std::string> expected{
-      "scene",         "grid",          "ranks",          "threads",
+      "scene",         "grid",          "ranks",          "threads",       "split",
       "integrator",    "dt",            "steps",          "sim_time",
-      "wall_seconds",  "node_steps_per_second",           "status",
+      "wall_seconds",  "node_steps_per_second",           "halo_seconds",
+      "restarted_from", "status",
       "unstable_step", "area_ratio",    "max_speed",      "kinetic_energy",
       "center_of_mass", "output"};
   EXPECT_EQ(keys, expected);
   EXPECT_NE(json.find(R"("grid": [32, 48])"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("restarted_from": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("dt": 0.0001,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("center_of_mass": [0.5, -0.25, 0])"), std::string::npos) << json;
   EXPECT_EQ(json.front(), '{');

@@ -1,44 +1,63 @@
 #pragma once
 // The HDF5 output of a run (shared/spec/SCENE_FORMAT.md, "Output"): one frame of positions per
-// write_frame, appended and flushed at once, with the XDMF file beside it rewritten each time,
-// so that a killed run leaves both files readable with every frame written so far.
+// write_frame, written collectively by every rank as its block's hyperslab (parallel HDF5),
+// appended and flushed at once, with the XDMF file beside it rewritten each time by rank 0, so
+// that a killed run leaves both files readable with every frame written so far.
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "cosserat/grid/block.hpp"
+#include "cosserat/model/vec3.hpp"
+
 namespace cosserat {
 
-// Every failure throws std::runtime_error naming the file and the operation that failed.
+namespace hdf5 {
+class File;
+}
+
+// Every failure throws std::runtime_error naming the file and the operation that failed. Every
+// member is collective over the block's communicator.
 class FrameWriter {
  public:
-  // Creates h5_path (truncating an existing file) for an m x n grid and records the scene text
-  // as read, the integrator name, the build version and the --set strings as root attributes.
-  FrameWriter(const std::string& h5_path, int m, int n, const std::string& scene_text,
+  // Creates h5_path (truncating an existing file) for the block's m x n grid and records the
+  // scene text as read, the integrator name, the build version and the --set strings as root
+  // attributes.
+  FrameWriter(const std::string& h5_path, const Block& block, const std::string& scene_text,
               const std::string& integrator, const std::string& version,
               const std::vector<std::string>& overrides);
+
+  // Reopens the output of an earlier run to continue it after a restart from `step`: the
+  // frames up to that step are kept, later ones (written after the checkpoint) dropped.
+  FrameWriter(const std::string& h5_path, const Block& block, long step);
+
   ~FrameWriter();
   FrameWriter(const FrameWriter&) = delete;
   FrameWriter& operator=(const FrameWriter&) = delete;
 
-  // positions holds m * n * 3 doubles laid out [k][l][xyz], l fastest: the C order of one
-  // frame of /positions. The frame is on disk and named in the XDMF file when this returns.
-  void write_frame(long step, double time, const double* positions);
+  // Appends the owned nodes of `positions` as one frame [k][l][xyz] of /positions. The frame
+  // is on disk and named in the XDMF file when this returns.
+  void write_frame(long step, double time, const Field<Vec3>& positions);
 
   // Writes or replaces a root string attribute, e.g. the final `status`.
   void set_attribute(const std::string& name, const std::string& value);
 
-  long frames() const;
+  long frames() const { return static_cast<long>(steps_.size()); }
+  long last_step() const { return steps_.empty() ? -1 : steps_.back(); }
 
  private:
-  // HDF5 handles stay in the .cpp so that hdf5.h is not pulled into every driver.
-  struct Hdf5Output;
-  std::unique_ptr<Hdf5Output> output_;
+  struct Datasets;
+  void write_xdmf_file() const;
+
+  const Block* block_;
+  std::unique_ptr<hdf5::File> file_;
+  std::unique_ptr<Datasets> datasets_;
   std::string h5_path_;
   std::string xmf_path_;
-  int m_;
-  int n_;
+  int rank_ = 0;
   std::vector<double> times_;
+  std::vector<long> steps_;
 };
 
 }  // namespace cosserat

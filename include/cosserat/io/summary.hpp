@@ -15,12 +15,15 @@ struct RunSummary {
   int n = 0;
   int ranks = 1;
   int threads = 1;
+  int parts_k = 1, parts_l = 1;  // the decomposition: blocks along k times along l
   std::string integrator;
   double dt = 0.0;
   long steps = 0;
   double sim_time = 0.0;
   double wall_seconds = 0.0;
   double node_steps_per_second = 0.0;
+  double halo_seconds = 0.0;  // wall time in halo exchanges, the largest over the ranks
+  std::optional<long> restarted_from;  // the checkpoint's step, for a restarted run
   std::string status;  // "ok" or "unstable"
   std::optional<long> unstable_step;
   double area_ratio = 0.0;  // S / S0 at the end

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/grid/reduce.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/model/vec3.hpp"
 
@@ -60,7 +61,8 @@ class CosseratModel {
 };
 
 // This block's share of the total area S: the two triangles of every cell whose lower-left
-// node it owns (MODEL.md §3), summed row by row in a fixed order.
-double block_area(const Field<Vec3>& positions);
+// node it owns (MODEL.md §3), each cell counted in multiples of `quantum` so that the global
+// total does not depend on the decomposition. Reads the ghosts at k + 1 and l + 1.
+QuantizedSum block_area(const Field<Vec3>& positions, double quantum);
 
 }  // namespace cosserat

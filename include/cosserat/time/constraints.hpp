@@ -25,6 +25,17 @@ class Constraints {
 
   bool empty() const { return nodes_.empty(); }
 
+  // What begin_step carries from one step to the next, per constrained node of this block:
+  // which components are held and the values they are held at. For checkpoints.
+  struct NodeState {
+    int k, l;
+    std::uint8_t held;
+    Vec3 value;
+  };
+  std::vector<NodeState> state() const;
+  // Takes over the entries for this block's constrained nodes; others are ignored.
+  void restore(const std::vector<NodeState>& states);
+
  private:
   struct Window {
     std::uint8_t axes;  // bit c set: component c held

@@ -34,7 +34,8 @@ class Dynamics {
 
   bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
   double rest_area() const { return rest_area_; }
-  double total_area(const Field<Vec3>& r) const;  // S, a global reduction
+  // S, a global reduction, the same bitwise for any decomposition; reads the ghosts of r.
+  double total_area(const Field<Vec3>& r) const;
 
  private:
   struct PointLoad {
@@ -46,6 +47,7 @@ class Dynamics {
   const Block* block_;
   CosseratModel model_;
   double h1h2_;
+  double area_quantum_;
   double mass_;
   double rest_area_;
   Vec3 gravity_;

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/grid/decomposition.hpp"
+#include "cosserat/grid/halo.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/dynamics.hpp"
 #include "cosserat/time/stepper.hpp"
@@ -24,33 +26,40 @@ struct Diagnostics {
 
 class Simulation {
  public:
+  // The scene on the ranks of comm, split by Decomposition::choose (throws
+  // DecompositionError when the grid is too small for that many ranks) or as given.
   Simulation(const Scene& scene, MPI_Comm comm);
+  Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& decomposition);
   Simulation(const Simulation&) = delete;
-
-  // Upper bound of the memory a run of `scene` takes on one rank: every field of the most
-  // demanding scheme, the force kernel's intermediates and the output buffer.
-  static double memory_bytes(const Scene& scene);
   Simulation& operator=(const Simulation&) = delete;
+
+  // Upper bound of the memory one rank's block takes: every field of the most demanding
+  // scheme, the force kernel's intermediates and the output buffer.
+  static double memory_bytes(const Block& block);
 
   std::optional<Instability> step() { return stepper_.step(); }
   long step_index() const { return stepper_.step_index(); }
   double time() const { return stepper_.time(); }
   const Block& block() const { return block_; }
+  const Decomposition& decomposition() const { return decomposition_; }
   const Field<Vec3>& positions() const { return stepper_.positions(); }
   const Field<Vec3>& velocities() { return stepper_.velocities(); }
+  // Wall time this rank spent in halo exchanges so far.
+  double halo_seconds() const { return halo_.seconds(); }
+
+  // The scheme's state for checkpoints (see Stepper::state_fields).
+  Stepper& stepper() { return stepper_; }
 
   Diagnostics diagnostics();
-
-  // Positions of the whole grid laid out [m][n][3] (l fastest), as the output file stores
-  // them; complete on rank 0.
-  std::vector<double> gather_positions() const;
 
  private:
   static Field<Vec3> rest_positions(const Scene& scene, const Block& block);
   static Field<Vec3> initial_velocities(const Scene& scene, const Block& block);
 
   const Scene* scene_;
+  Decomposition decomposition_;
   Block block_;
+  Halo halo_;
   Dynamics dynamics_;
   Stepper stepper_;
 };

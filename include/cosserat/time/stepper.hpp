@@ -3,8 +3,11 @@
 // every stage, and the stability monitor of §4.2.
 
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/grid/halo.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
 #include "cosserat/time/dynamics.hpp"
@@ -21,13 +24,25 @@ struct Instability {
 
 class Stepper {
  public:
-  // Takes the state at step 0: positions with ghosts, velocities.
-  Stepper(const Scene& scene, const Block& block, Dynamics& dynamics,
+  // Takes the state at step 0: positions, velocities. Exchanges the ghosts of every position
+  // field before the forces read it.
+  Stepper(const Scene& scene, const Block& block, Halo& halo, Dynamics& dynamics,
           const Field<Vec3>& positions, const Field<Vec3>& velocities);
 
   // Advances one step. On instability the state is left at the last good step and the
   // failure is returned.
   std::optional<Instability> step();
+
+  // The fields that carry the scheme's state from one step to the next: together with the
+  // step index and the constraints' state, all a restart needs to continue bitwise.
+  struct StateField {
+    std::string name;
+    Field<Vec3>* field;
+  };
+  std::vector<StateField> state_fields();
+  Constraints& constraints() { return constraints_; }
+  // Continues from `step` after the state fields and constraints were overwritten.
+  void resume(long step);
 
   long step_index() const { return step_; }
   double time() const { return time_; }
@@ -49,6 +64,7 @@ class Stepper {
   void hold(Field<Vec3>& r, Field<Vec3>& v) const;
 
   const Block* block_;
+  Halo* halo_;
   Dynamics* dynamics_;
   Constraints constraints_;
   Integrator scheme_;

@@ -1,0 +1,51 @@
+#pragma once
+// Halo exchange of a block's ghost rings with the up to eight neighbouring blocks (DESIGN.md
+// principle 1). Width kGhostWidth = 2, the reach of the force stencil (MODEL.md §2.4, derived
+// in model/cosserat_model.cpp): a node's force reads positions up to two nodes away along
+// each axis and diagonally (the box stencil), so the corner blocks are neighbours too. The
+// intermediates (resultants, tractions) are recomputed on the ring rather than exchanged, so
+// one exchange of positions per force evaluation is all the kernel needs. Ghosts outside the
+// grid are never written: the physical-border rules test the global index and do not read them.
+
+#include <mpi.h>
+
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/grid/decomposition.hpp"
+#include "cosserat/model/vec3.hpp"
+
+namespace cosserat {
+
+class Halo {
+ public:
+  Halo(const Decomposition& decomposition, const Block& block, int rank);
+  ~Halo();
+  Halo(const Halo&) = delete;
+  Halo& operator=(const Halo&) = delete;
+
+  // Fills the ghost nodes inside the grid with the owners' values. Collective over the
+  // neighbours: every rank calls it for the same field at the same point. Call outside
+  // OpenMP parallel regions (MPI_THREAD_FUNNELED).
+  void exchange(Field<Vec3>& field);
+
+  // Wall time spent in exchange() so far, and the number of calls.
+  double seconds() const { return seconds_; }
+  long exchanges() const { return exchanges_; }
+
+ private:
+  struct Neighbour {
+    int rank;
+    MPI_Datatype send, receive;  // subarrays of the local field
+    int send_tag, receive_tag;
+  };
+
+  MPI_Comm comm_;
+  MPI_Datatype node_type_;
+  std::vector<Neighbour> neighbours_;
+  std::vector<MPI_Request> requests_;
+  double seconds_ = 0.0;
+  long exchanges_ = 0;
+};
+
+}  // namespace cosserat

@@ -1,0 +1,34 @@
+#pragma once
+// Checkpoints: the whole state of a run in one HDF5 file, written collectively, from which a
+// restart continues bitwise as if never interrupted (on any number of ranks: the fields are
+// stored as whole-grid arrays, not per rank).
+
+#include <stdexcept>
+#include <string>
+
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/simulation.hpp"
+
+namespace cosserat {
+
+// A file that is not a checkpoint of this scene: bad input, reported before any step.
+class CheckpointError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// `<output stem>.checkpoint.h5` beside the output file.
+std::string checkpoint_path(const std::string& output_path);
+
+// Writes the state of `simulation` to `path`: first to `path`.partial, renamed over `path` only
+// once complete and closed, so a run killed while writing leaves the previous checkpoint
+// valid. Collective. Throws std::runtime_error on I/O failure.
+void write_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
+                      const std::string& version);
+
+// Loads a checkpoint into `simulation`, built for `scene` on any decomposition, and returns its
+// step. Throws CheckpointError if the file cannot be read as a checkpoint or was written for a
+// different grid, integrator or time step. Collective.
+long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene);
+
+}  // namespace cosserat

@@ -1,0 +1,197 @@
+#include "cosserat/io/checkpoint.hpp"
+
+#include <filesystem>
+#include <system_error>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "hdf5_file.hpp"
+
+namespace cosserat {
+
+using hdf5::Handle;
+
+namespace {
+
+constexpr const char* kFormat = "cosserat checkpoint 1";
+
+int rank_in(MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  return rank;
+}
+
+Handle create_dataset(const hdf5::File& file, const std::string& name, hid_t type,
+                      const std::vector<hsize_t>& dims) {
+  const std::string what = fmt::format("create dataset {}", name);
+  const Handle space = file.open(
+      H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, what);
+  return file.open(H5Dcreate2(file.get(), name.c_str(), type, space.get(), H5P_DEFAULT,
+                              H5P_DEFAULT, H5P_DEFAULT),
+                   H5Dclose, what);
+}
+
+// Rows [offset, offset + rows) of a dataset [total][columns] from this rank; collective.
+void write_rows(const hdf5::File& file, const Handle& dataset, hid_t memory_type,
+                hsize_t offset, hsize_t rows, hsize_t columns, const void* values,
+                const std::string& what) {
+  const Handle file_space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  const std::array<hsize_t, 2> start{offset, 0}, count{rows, columns};
+  const int rank = H5Sget_simple_extent_ndims(file_space.get());
+  const Handle memory_space =
+      file.open(H5Screate_simple(rank, count.data(), nullptr), H5Sclose, what);
+  if (rows > 0)
+    file.check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr,
+                                   count.data(), nullptr),
+               what + " (select)");
+  else
+    file.check(H5Sselect_none(file_space.get()), what + " (select)");
+  if (rows == 0) file.check(H5Sselect_none(memory_space.get()), what + " (select)");
+  file.check(H5Dwrite(dataset.get(), memory_type, memory_space.get(), file_space.get(),
+                      file.collective(), values),
+             what);
+}
+
+template <class T>
+std::vector<T> read_all(const hdf5::File& file, const std::string& name, hid_t memory_type,
+                        std::size_t values_per_row) {
+  const std::string what = fmt::format("read {}", name);
+  const Handle dataset =
+      file.open(H5Dopen2(file.get(), name.c_str(), H5P_DEFAULT), H5Dclose, what);
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  const hssize_t points = H5Sget_simple_extent_npoints(space.get());
+  file.check(static_cast<hid_t>(points), what);
+  std::vector<T> values(static_cast<std::size_t>(points));
+  if (values.size() != 0)
+    file.check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, file.independent(),
+                       values.data()),
+               what);
+  if (values.size() % values_per_row != 0) file.fail(what + " (shape)");
+  return values;
+}
+
+// The constraints of every rank as one list, each rank writing its own stretch.
+void write_constraints(const hdf5::File& file, const Constraints& constraints, MPI_Comm comm) {
+  const std::vector<Constraints::NodeState> local = constraints.state();
+  const long count = static_cast<long>(local.size());
+  long offset = 0, total = 0;
+  MPI_Exscan(&count, &offset, 1, MPI_LONG, MPI_SUM, comm);
+  if (rank_in(comm) == 0) offset = 0;
+  MPI_Allreduce(&count, &total, 1, MPI_LONG, MPI_SUM, comm);
+
+  std::vector<std::int32_t> nodes;
+  std::vector<std::uint8_t> held;
+  std::vector<double> values;
+  for (const Constraints::NodeState& s : local) {
+    nodes.insert(nodes.end(), {s.k, s.l});
+    held.push_back(s.held);
+    values.insert(values.end(), {s.value.x, s.value.y, s.value.z});
+  }
+  const auto rows = static_cast<hsize_t>(count), at = static_cast<hsize_t>(offset);
+  const auto all = static_cast<hsize_t>(total);
+  const Handle node_set = create_dataset(file, "/constraint_nodes", H5T_STD_I32LE, {all, 2});
+  const Handle held_set = create_dataset(file, "/constraint_held", H5T_STD_U8LE, {all, 1});
+  const Handle value_set = create_dataset(file, "/constraint_values", H5T_IEEE_F64LE, {all, 3});
+  if (all == 0) return;
+  write_rows(file, node_set, H5T_NATIVE_INT32, at, rows, 2, nodes.data(), "write constraints");
+  write_rows(file, held_set, H5T_NATIVE_UINT8, at, rows, 1, held.data(), "write constraints");
+  write_rows(file, value_set, H5T_NATIVE_DOUBLE, at, rows, 3, values.data(), "write constraints");
+}
+
+std::vector<Constraints::NodeState> read_constraints(const hdf5::File& file) {
+  const auto nodes = read_all<std::int32_t>(file, "/constraint_nodes", H5T_NATIVE_INT32, 2);
+  const auto held = read_all<std::uint8_t>(file, "/constraint_held", H5T_NATIVE_UINT8, 1);
+  const auto values = read_all<double>(file, "/constraint_values", H5T_NATIVE_DOUBLE, 3);
+  if (nodes.size() != 2 * held.size() || values.size() != 3 * held.size())
+    file.fail("read constraints (lengths differ)");
+  std::vector<Constraints::NodeState> states;
+  for (std::size_t i = 0; i < held.size(); ++i)
+    states.push_back({nodes[2 * i], nodes[2 * i + 1], held[i],
+                      Vec3{values[3 * i], values[3 * i + 1], values[3 * i + 2]}});
+  return states;
+}
+
+}  // namespace
+
+std::string checkpoint_path(const std::string& output_path) {
+  std::filesystem::path path(output_path);
+  path.replace_extension(".checkpoint.h5");
+  return path.string();
+}
+
+void write_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
+                      const std::string& version) {
+  const Block& b = simulation.block();
+  const std::string partial = path + ".partial";
+  {
+    const hdf5::File file(partial, b.comm, hdf5::File::Mode::create);
+    file.write_attribute("format", std::string(kFormat));
+    file.write_attribute("version", version);
+    file.write_attribute("scene", scene.text);
+    file.write_attribute("integrator", std::string(integrator_name(scene.integrator)));
+    file.write_attribute("m", std::int64_t{scene.m});
+    file.write_attribute("n", std::int64_t{scene.n});
+    file.write_attribute("dt", scene.dt);
+    file.write_attribute("step", std::int64_t{simulation.step_index()});
+    file.write_attribute("time", simulation.time());
+    const std::vector<hsize_t> shape{static_cast<hsize_t>(b.m), static_cast<hsize_t>(b.n), 3};
+    for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
+      const Handle dataset = create_dataset(file, "/" + f.name, H5T_IEEE_F64LE, shape);
+      file.write_block(dataset.get(), *f.field, {}, "write /" + f.name);
+    }
+    write_constraints(file, simulation.stepper().constraints(), b.comm);
+    file.flush();
+  }
+  // Every rank has closed the file; only then does it replace the previous checkpoint.
+  MPI_Barrier(b.comm);
+  int renamed = 1;
+  std::string reason;
+  if (rank_in(b.comm) == 0) {
+    std::error_code error;
+    std::filesystem::rename(partial, path, error);
+    renamed = error ? 0 : 1;
+    reason = error.message();
+  }
+  MPI_Bcast(&renamed, 1, MPI_INT, 0, b.comm);
+  if (renamed == 0)
+    throw std::runtime_error(fmt::format("cannot rename checkpoint '{}' to '{}': {}", partial,
+                                         path, reason.empty() ? "see rank 0" : reason));
+}
+
+long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene) {
+  const Block& b = simulation.block();
+  try {
+    const hdf5::File file(path, b.comm, hdf5::File::Mode::read);
+    if (file.read_string_attribute("format") != kFormat)
+      throw CheckpointError(fmt::format("'{}' is not a cosserat checkpoint", path));
+    const long m = file.read_int_attribute("m"), n = file.read_int_attribute("n");
+    const std::string integrator = file.read_string_attribute("integrator");
+    const double dt = file.read_double_attribute("dt");
+    if (m != scene.m || n != scene.n || integrator != integrator_name(scene.integrator) ||
+        dt != scene.dt)
+      throw CheckpointError(fmt::format(
+          "checkpoint '{}' was written for a {} x {} grid with {} at dt = {} s; this scene has "
+          "{} x {} with {} at dt = {} s",
+          path, m, n, integrator, dt, scene.m, scene.n, integrator_name(scene.integrator),
+          scene.dt));
+    const long step = file.read_int_attribute("step");
+    if (step < 0 || step > scene.steps)
+      throw CheckpointError(fmt::format("checkpoint '{}' is at step {}, past this scene's {} steps",
+                                        path, step, scene.steps));
+    for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
+      const Handle dataset = file.open(H5Dopen2(file.get(), ("/" + f.name).c_str(), H5P_DEFAULT),
+                                       H5Dclose, "open /" + f.name);
+      file.read_block(dataset.get(), *f.field, "read /" + f.name);
+    }
+    simulation.stepper().constraints().restore(read_constraints(file));
+    simulation.stepper().resume(step);
+    return step;
+  } catch (const CheckpointError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    throw CheckpointError(fmt::format("cannot restart from '{}': {}", path, e.what()));
+  }
+}
+
+}  // namespace cosserat
