@@ -6,6 +6,7 @@
 #include <hdf5.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -82,7 +83,8 @@ TEST_F(Cli, HelpDocumentsEveryOption) {
   EXPECT_THAT(top.output, HasSubstr("Exit status"));
   const Result run = cosserat("run --help");
   EXPECT_EQ(run.status, 0);
-  for (const char* option : {"--set", "--output", "--summary", "--quiet"})
+  for (const char* option : {"--set", "--output", "--summary", "--quiet", "--checkpoint-every",
+                             "--restart"})
     EXPECT_THAT(run.output, HasSubstr(option));
 }
 
@@ -188,6 +190,112 @@ TEST_F(Cli, BlowUpStopsWithItsOwnStatusAndKeepsWork) {
   json << std::ifstream(path("bad.json")).rdbuf();
   EXPECT_THAT(json.str(), HasSubstr("\"status\": \"unstable\""));
   EXPECT_THAT(json.str(), ::testing::Not(HasSubstr("\"unstable_step\": null")));
+}
+
+// Every dataset of an output file as raw bytes, by name.
+std::vector<std::vector<unsigned char>> read_datasets(const std::string& file) {
+  std::vector<std::vector<unsigned char>> all;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return all;
+  for (const char* name : {"/positions", "/time", "/step"}) {
+    const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    const hid_t t = H5Dget_type(d);
+    const hid_t s = H5Dget_space(d);
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)) *
+                                     H5Tget_size(t));
+    H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, bytes.data());
+    all.push_back(std::move(bytes));
+    H5Sclose(s);
+    H5Tclose(t);
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return all;
+}
+
+// A run stopped after a checkpoint and restarted with more steps ends where an uninterrupted
+// run ends, bitwise; its output file holds the frames of both parts.
+TEST_F(Cli, RestartContinuesARunBitwise) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  ASSERT_EQ(cosserat("run " + scene + " -q -o " + path("whole.h5")).status, 0);
+  const Result first = cosserat("run " + scene + " -q --set time.steps=120 --checkpoint-every 50 -o " +
+                                path("part.h5"));
+  ASSERT_EQ(first.status, 0) << first.output;
+  ASSERT_TRUE(fs::exists(path("part.checkpoint.h5")));
+  EXPECT_FALSE(fs::exists(path("part.checkpoint.h5.partial")));
+  const Result second = cosserat("run " + scene + " --restart " + path("part.checkpoint.h5") +
+                                 " -o " + path("part.h5") + " --summary " + path("part.json"));
+  ASSERT_EQ(second.status, 0) << second.output;
+  EXPECT_THAT(second.output, HasSubstr("at step 120"));
+  // Frames 0, 50, 100, 120 from the first part, 150 and 200 from the second.
+  EXPECT_EQ(read_frames(path("part.h5")).first, 6);
+  const auto whole = read_datasets(path("whole.h5")), part = read_datasets(path("part.h5"));
+  ASSERT_EQ(whole.size(), 3u);
+  ASSERT_EQ(part.size(), 3u);
+  const std::size_t frame_bytes = 6 * 6 * 3 * sizeof(double);
+  ASSERT_EQ(part[0].size(), 6 * frame_bytes);
+  EXPECT_TRUE(std::equal(part[0].end() - frame_bytes, part[0].end(), whole[0].end() - frame_bytes))
+      << "the last frames differ";
+  std::stringstream json;
+  json << std::ifstream(path("part.json")).rdbuf();
+  EXPECT_THAT(json.str(), HasSubstr("\"restarted_from\": 120"));
+}
+
+// A run killed (SIGKILL) at some point after its first checkpoint, then restarted: the output
+// file ends up identical, dataset by dataset, to that of a run never interrupted, whatever
+// frames the killed run had written past its checkpoint.
+TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string longer = " --set grid.nodes=[30,30] --set time.steps=20000 --set time.output_every=1000 ";
+  ASSERT_EQ(cosserat("run " + scene + longer + "-q -o " + path("whole.h5")).status, 0);
+  const std::string run = std::string(COSSERAT_EXE) + " run " + scene + longer +
+                          "-q --checkpoint-every 1500 -o " + path("killed.h5");
+  const std::string kill_after_checkpoint =
+      "sh -c '" + run + " & pid=$!; while [ ! -f " + path("killed.checkpoint.h5") +
+      " ]; do sleep 0.01; done; sleep 0.3; kill -9 $pid; wait $pid; echo killed $?'";
+  FILE* pipe = popen(kill_after_checkpoint.c_str(), "r");
+  std::array<char, 256> line{};
+  std::string said;
+  while (std::fgets(line.data(), line.size(), pipe)) said += line.data();
+  pclose(pipe);
+  ASSERT_THAT(said, HasSubstr("killed 137")) << "the run ended before it was killed: " << said;
+
+  const Result restarted = cosserat("run " + scene + longer + "-q --restart " +
+                                    path("killed.checkpoint.h5") + " -o " + path("killed.h5"));
+  ASSERT_EQ(restarted.status, 0) << restarted.output;
+  const auto whole = read_datasets(path("whole.h5")), killed = read_datasets(path("killed.h5"));
+  ASSERT_EQ(whole.size(), 3u);
+  ASSERT_EQ(killed.size(), 3u);
+  EXPECT_TRUE(killed[0] == whole[0]) << "/positions differ";
+  EXPECT_TRUE(killed[1] == whole[1]) << "/time differs";
+  EXPECT_TRUE(killed[2] == whole[2]) << "/step differs";
+}
+
+TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=10 --checkpoint-every 10 -o " + path("a.h5")).status, 0);
+  const Result r = cosserat("run " + scene + " --set time.dt=0.002 --restart " +
+                            path("a.checkpoint.h5") + " -o " + path("b.h5"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_THAT(r.output, HasSubstr("dt = 0.002"));
+  EXPECT_EQ(cosserat("run " + scene + " --restart " + path("absent.h5")).status, 2);
+}
+
+// More ranks than a 3 x 6 grid can be split over (every block must be two nodes wide).
+TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string command = std::string(COSSERAT_MPIEXEC) +
+                              " -n 4 --oversubscribe --allow-run-as-root " + COSSERAT_EXE +
+                              " run " + scene + " --set grid.nodes=[3,6] -o " + path("x.h5") +
+                              " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  std::string output;
+  std::array<char, 4096> buffer{};
+  while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
+  const int raw = pclose(pipe);
+  EXPECT_EQ(WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, 2) << output;
+  EXPECT_THAT(output, HasSubstr("cannot be split over 4 MPI ranks"));
+  EXPECT_FALSE(fs::exists(path("x.h5")));
 }
 
 }  // namespace

@@ -1,0 +1,116 @@
+#pragma once
+// Helpers of the tests under mpiexec: the ranks of MPI_COMM_WORLD, the splits of a grid over
+// them, a scene whose loads and fixes straddle block borders, and node-by-node comparison of a
+// distributed field with the same field of a one-block run.
+
+#include <mpi.h>
+
+#include <string>
+#include <vector>
+
+#include "cosserat/grid/decomposition.hpp"
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/simulation.hpp"
+
+namespace cosserat::testing {
+
+inline int world_rank() {
+  int rank = 0;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  return rank;
+}
+
+inline int world_size() {
+  int size = 1;
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  return size;
+}
+
+inline std::vector<Integrator> all_integrators() {
+  std::vector<Integrator> all;
+  for (const std::string& name : integrator_names()) all.push_back(*integrator_from_name(name));
+  return all;
+}
+
+// Every parts_k x parts_l = ranks split that fits the grid, the automatic choice first.
+inline std::vector<Decomposition> all_splits(int m, int n, int ranks) {
+  std::vector<Decomposition> splits{Decomposition::choose(m, n, ranks)};
+  for (int parts_k = 1; parts_k <= ranks; ++parts_k) {
+    if (ranks % parts_k != 0) continue;
+    const int parts_l = ranks / parts_k;
+    if (parts_k == splits.front().parts_k()) continue;
+    try {
+      splits.push_back(Decomposition::with_parts(m, n, parts_k, parts_l));
+    } catch (const DecompositionError&) {
+      // This split does not fit the grid; the others still test it.
+    }
+  }
+  return splits;
+}
+
+// 37 x 23, odd in both directions, so every split is uneven. Two corners held from the start;
+// a band fixed in y only from step 30; a load on a disk for steps 0-50; fluid and damping, so
+// that the total area enters every step. The band, the disk and the fixed corners straddle the
+// block borders of every split of 2 to 6 ranks.
+inline Scene odd_grid_scene(Integrator integrator) {
+  Scene scene = parse_scene(R"(
+title = "odd grid"
+[grid]
+nodes = [37, 23]
+size = [9.0, 5.5]
+origin = [0.0, 0.0, 0.0]
+u = [1.0, 0.0, 0.0]
+v = [0.0, 0.0, 1.0]
+[material]
+mass = 10.0
+zeta = 100.0
+xi = 0.3
+phi = 0.05
+[environment]
+gravity = [0.0, -9.8, 0.0]
+damping = 0.2
+fluid = { viscosity = 0.5, velocity = [1.0, 0.0, 0.5] }
+[time]
+integrator = "verlet"
+dt = 0.001
+steps = 80
+output_every = 20
+[[fix]]
+nodes = [[0, 0], [36, 0]]
+[[fix]]
+region = { rect = [10, 8, 26, 13] }
+axes = "y"
+start = 30
+[[load]]
+region = { disk = { center = [18, 11], radius = 6 } }
+force = [0.0, 2.0, 0.3]
+start = 0
+end = 50
+)",
+                            "odd_grid.toml");
+  scene.integrator = integrator;
+  return scene;
+}
+
+// Number of owned nodes, over all ranks, where `field` differs in any bit from `reference`,
+// a field of the whole grid.
+inline long differing_nodes(const Field<Vec3>& field, const Field<Vec3>& reference) {
+  const Block& b = field.block();
+  const Block& whole = reference.block();
+  if (whole.owned_k() != whole.m || whole.owned_l() != whole.n) return -1;
+  long local = 0;
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      const Vec3 p = field(k, l), q = reference(k, l);
+      if (!(p.x == q.x && p.y == q.y && p.z == q.z)) ++local;
+    }
+  long total = 0;
+  MPI_Allreduce(&local, &total, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+  return total;
+}
+
+inline std::string split_name(const Decomposition& d) {
+  return std::to_string(d.parts_k()) + " x " + std::to_string(d.parts_l());
+}
+
+}  // namespace cosserat::testing

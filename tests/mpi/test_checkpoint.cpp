@@ -1,0 +1,151 @@
+// Checkpoint, restart and collective output under mpiexec. A restart continues bitwise: on the
+// same ranks with another split, and on one rank from a checkpoint written by P. The output of
+// P ranks reads back equal to the output of one.
+
+#include <gtest/gtest.h>
+#include <hdf5.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "cosserat/io/checkpoint.hpp"
+#include "cosserat/io/frame_writer.hpp"
+#include "mpi_support.hpp"
+#include "support/sheets.hpp"
+
+namespace cosserat {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::all_integrators;
+using testing::all_splits;
+using testing::differing_nodes;
+using testing::world_rank;
+using testing::world_size;
+
+// A folder every rank sees, made by rank 0 and removed when the test ends.
+class SharedFolder : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    long pid = getpid();
+    MPI_Bcast(&pid, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+    const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+    folder_ = fs::temp_directory_path() /
+              ("cosserat_mpi_" + std::to_string(pid) + "_" + test->name());
+    if (world_rank() == 0) fs::create_directories(folder_);
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
+  void TearDown() override {
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (world_rank() == 0) fs::remove_all(folder_);
+  }
+
+  fs::path folder_;
+};
+
+using Restart = SharedFolder;
+
+TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
+  const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
+  for (const Integrator integrator : all_integrators()) {
+    const Scene scene = testing::odd_grid_scene(integrator);  // 80 steps
+    const long half = scene.steps / 2;
+    const auto splits = all_splits(scene.m, scene.n, world_size());
+    Simulation uninterrupted(scene, MPI_COMM_SELF);  // one block: the comparisons' reference
+    ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
+
+    {
+      Simulation first(scene, MPI_COMM_WORLD);
+      ASSERT_TRUE(testing::advance(first, half));
+      write_checkpoint(checkpoint, first, scene, "test");
+    }
+    Simulation other_split(scene, MPI_COMM_WORLD, splits.back());
+    EXPECT_EQ(read_checkpoint(checkpoint, other_split, scene), half);
+    ASSERT_TRUE(testing::advance(other_split, scene.steps - half));
+    EXPECT_EQ(other_split.step_index(), scene.steps);
+    EXPECT_EQ(differing_nodes(other_split.positions(), uninterrupted.positions()), 0)
+        << integrator_name(integrator) << ", split " << testing::split_name(splits.back());
+    EXPECT_EQ(differing_nodes(other_split.velocities(), uninterrupted.velocities()), 0)
+        << integrator_name(integrator);
+
+    // Every rank restarts the whole grid alone from the file the P ranks wrote.
+    Simulation one_rank(scene, MPI_COMM_SELF);
+    EXPECT_EQ(read_checkpoint(checkpoint, one_rank, scene), half);
+    ASSERT_TRUE(testing::advance(one_rank, scene.steps - half));
+    EXPECT_EQ(differing_nodes(one_rank.positions(), uninterrupted.positions()), 0)
+        << integrator_name(integrator) << " restarted on one rank";
+    EXPECT_EQ(differing_nodes(one_rank.velocities(), uninterrupted.velocities()), 0)
+        << integrator_name(integrator) << " restarted on one rank";
+    MPI_Barrier(MPI_COMM_WORLD);  // every rank has read it before the next scheme's replaces it
+  }
+}
+
+TEST_F(Restart, RefusesACheckpointOfAnotherGridOrStep) {
+  const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
+  const Scene scene = testing::odd_grid_scene(Integrator::verlet);
+  {
+    Simulation sim(scene, MPI_COMM_WORLD);
+    ASSERT_TRUE(testing::advance(sim, 5));
+    write_checkpoint(checkpoint, sim, scene, "test");
+  }
+  EXPECT_FALSE(fs::exists(checkpoint + ".partial"));
+  Scene other_dt = scene;
+  other_dt.dt *= 0.5;
+  Simulation sim(other_dt, MPI_COMM_WORLD);
+  EXPECT_THROW(read_checkpoint(checkpoint, sim, other_dt), CheckpointError);
+  Scene other_scheme = scene;
+  other_scheme.integrator = Integrator::rk4;
+  Simulation rk4(other_scheme, MPI_COMM_WORLD);
+  EXPECT_THROW(read_checkpoint(checkpoint, rk4, other_scheme), CheckpointError);
+  EXPECT_THROW(read_checkpoint((folder_ / "missing.h5").string(), sim, other_dt), CheckpointError);
+}
+
+std::vector<unsigned char> dataset_bytes(const std::string& path, const char* name) {
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  const hid_t dataset = H5Dopen2(file, name, H5P_DEFAULT);
+  const hid_t type = H5Dget_type(dataset);
+  const hid_t space = H5Dget_space(dataset);
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)) *
+                                   H5Tget_size(type));
+  H5Dread(dataset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, bytes.data());
+  H5Sclose(space);
+  H5Tclose(type);
+  H5Dclose(dataset);
+  H5Fclose(file);
+  return bytes;
+}
+
+using Output = SharedFolder;
+
+TEST_F(Output, OfPRanksReadsBackEqualToOneRank) {
+  const Scene scene = testing::odd_grid_scene(Integrator::verlet);
+  const std::string parallel = (folder_ / "parallel.h5").string();
+  const std::string serial = (folder_ / "serial.h5").string();
+  auto run = [&](const std::string& path, MPI_Comm comm) {
+    Simulation sim(scene, comm);
+    FrameWriter writer(path, sim.block(), scene.text, "verlet", "test", {});
+    writer.write_frame(sim.step_index(), sim.time(), sim.positions());
+    for (int frame = 0; frame < 4; ++frame) {
+      testing::advance(sim, scene.output_every);
+      writer.write_frame(sim.step_index(), sim.time(), sim.positions());
+    }
+  };
+  run(parallel, MPI_COMM_WORLD);
+  if (world_rank() == 0) run(serial, MPI_COMM_SELF);
+  MPI_Barrier(MPI_COMM_WORLD);
+
+  int equal = 1;
+  if (world_rank() == 0)
+    for (const char* name : {"/positions", "/time", "/step"}) {
+      const auto a = dataset_bytes(parallel, name), b = dataset_bytes(serial, name);
+      equal = equal && !a.empty() && a == b;
+    }
+  MPI_Bcast(&equal, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  EXPECT_TRUE(equal) << "P = " << world_size();
+}
+
+}  // namespace
+}  // namespace cosserat
