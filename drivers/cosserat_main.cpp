@@ -133,10 +133,12 @@ int run(const RunOptions& options, int rank, int ranks) {
 
   const std::string output = options.output.empty() ? default_output(scene) : options.output;
   std::unique_ptr<FrameWriter> writer;
+  bool continued = false;
   try {
     // A restart continues the earlier run's file when there is one: the frames up to the
     // checkpoint are kept, and the frames written after it are written again.
-    if (restarted_from && std::filesystem::exists(output))
+    continued = restarted_from && std::filesystem::exists(output);
+    if (continued)
       writer = std::make_unique<FrameWriter>(output, simulation.block(), *restarted_from);
     else
       writer = std::make_unique<FrameWriter>(output, simulation.block(), scene.text,
@@ -163,7 +165,9 @@ int run(const RunOptions& options, int rank, int ranks) {
   auto write_frame = [&] {
     writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions());
   };
-  if (writer->last_step() != simulation.step_index()) write_frame();
+  // A continued file already holds every scheduled frame up to the checkpoint; a new file starts
+  // with the state the run starts from.
+  if (!continued) write_frame();
   const long first_step = simulation.step_index();
   Progress progress(scene.steps, scene.dt, on_terminal);
   const auto start = Clock::now();

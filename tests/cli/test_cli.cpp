@@ -241,9 +241,9 @@ TEST_F(Cli, RestartContinuesARunBitwise) {
   EXPECT_THAT(json.str(), HasSubstr("\"restarted_from\": 120"));
 }
 
-// A run killed (SIGKILL) at some point after its first checkpoint, then restarted: the output
-// file ends up identical, dataset by dataset, to that of a run never interrupted, whatever
-// frames the killed run had written past its checkpoint.
+// A run killed (SIGKILL) soon after its first checkpoint (step 1500, between two frames), then
+// restarted: the output file ends up identical, dataset by dataset, to that of a run never
+// interrupted, whatever frames the killed run had written past its checkpoint.
 TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   const std::string longer = " --set grid.nodes=[30,30] --set time.steps=20000 --set time.output_every=1000 ";
@@ -252,7 +252,7 @@ TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
                           "-q --checkpoint-every 1500 -o " + path("killed.h5");
   const std::string kill_after_checkpoint =
       "sh -c '" + run + " & pid=$!; while [ ! -f " + path("killed.checkpoint.h5") +
-      " ]; do sleep 0.01; done; sleep 0.3; kill -9 $pid; wait $pid; echo killed $?'";
+      " ]; do sleep 0.01; done; sleep 0.05; kill -9 $pid; wait $pid; echo killed $?'";
   FILE* pipe = popen(kill_after_checkpoint.c_str(), "r");
   std::array<char, 256> line{};
   std::string said;
