@@ -169,6 +169,7 @@ int run(const RunOptions& options, int rank, int ranks) {
   // with the state the run starts from.
   if (!continued) write_frame();
   const long first_step = simulation.step_index();
+  const double halo_before = simulation.halo_seconds();
   Progress progress(scene.steps, scene.dt, on_terminal);
   const auto start = Clock::now();
   std::optional<Instability> failure;
@@ -218,7 +219,7 @@ int run(const RunOptions& options, int rank, int ranks) {
   summary.wall_seconds = wall;
   summary.node_steps_per_second =
       wall > 0.0 ? static_cast<double>(scene.m) * scene.n * steps_run / wall : 0.0;
-  summary.halo_seconds = global_max(simulation.halo_seconds(), MPI_COMM_WORLD);
+  summary.halo_seconds = global_max(simulation.halo_seconds() - halo_before, MPI_COMM_WORLD);
   summary.restarted_from = restarted_from;
   summary.status = failure ? "unstable" : "ok";
   if (failure) summary.unstable_step = failure->step;

@@ -1,6 +1,7 @@
 #include "cosserat/grid/halo.hpp"
 
 #include <array>
+#include <cassert>
 
 namespace cosserat {
 
@@ -59,9 +60,11 @@ Halo::~Halo() {
   MPI_Type_free(&node_type_);
 }
 
-void Halo::exchange(Field<Vec3>& field) {
+void Halo::begin(Field<Vec3>& field) {
+  assert(in_flight_ == nullptr && "one halo exchange at a time");
   if (neighbours_.empty()) return;
-  const double start = MPI_Wtime();
+  in_flight_ = &field;
+  started_ = MPI_Wtime();
   // Send and receive regions are disjoint (owned bands, ghost bands), so all transfers of
   // one field may be in flight at once.
   std::size_t r = 0;
@@ -69,9 +72,25 @@ void Halo::exchange(Field<Vec3>& field) {
     MPI_Irecv(field.data(), 1, n.receive, n.rank, n.receive_tag, comm_, &requests_[r++]);
   for (const Neighbour& n : neighbours_)
     MPI_Isend(field.data(), 1, n.send, n.rank, n.send_tag, comm_, &requests_[r++]);
+}
+
+void Halo::end() {
+  if (in_flight_ == nullptr) return;
+#ifdef NDEBUG
   MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE);
-  seconds_ += MPI_Wtime() - start;
+#else
+  // Each receive must be exactly the band the neighbour sent: same node count both ways.
+  std::vector<MPI_Status> statuses(requests_.size());
+  MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), statuses.data());
+  for (std::size_t i = 0; i < neighbours_.size(); ++i) {
+    int count = 0;
+    MPI_Get_count(&statuses[i], neighbours_[i].receive, &count);
+    assert(count == 1 && "halo band sizes of neighbouring blocks disagree");
+  }
+#endif
+  seconds_ += MPI_Wtime() - started_;
   ++exchanges_;
+  in_flight_ = nullptr;
 }
 
 }  // namespace cosserat

@@ -26,8 +26,15 @@ class Halo {
 
   // Fills the ghost nodes inside the grid with the owners' values. Collective over the
   // neighbours: every rank calls it for the same field at the same point. Call outside
-  // OpenMP parallel regions (MPI_THREAD_FUNNELED).
-  void exchange(Field<Vec3>& field);
+  // OpenMP parallel regions (MPI_THREAD_FUNNELED). begin() posts the receives, then the sends;
+  // the owned nodes may be read (not written) and the ghosts neither until end() returns;
+  // exchange() is both. One exchange at a time.
+  void begin(Field<Vec3>& field);
+  void end();
+  void exchange(Field<Vec3>& field) {
+    begin(field);
+    end();
+  }
 
   // Wall time spent in exchange() so far, and the number of calls.
   double seconds() const { return seconds_; }
@@ -44,6 +51,8 @@ class Halo {
   MPI_Datatype node_type_;
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
+  Field<Vec3>* in_flight_ = nullptr;
+  double started_ = 0.0;
   double seconds_ = 0.0;
   long exchanges_ = 0;
 };
