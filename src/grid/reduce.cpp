@@ -1,5 +1,7 @@
 #include "cosserat/grid/reduce.hpp"
 
+#include "cosserat/grid/block.hpp"
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -8,8 +10,7 @@
 namespace cosserat {
 
 double global_sum(double local, MPI_Comm comm) {
-  int size = 1;
-  MPI_Comm_size(comm, &size);
+  const int size = size_of(comm);
   std::vector<double> partials(static_cast<std::size_t>(size));
   MPI_Allgather(&local, 1, MPI_DOUBLE, partials.data(), 1, MPI_DOUBLE, comm);
   double sum = 0.0;
@@ -34,8 +35,7 @@ double QuantizedSum::global_total(MPI_Comm comm) const {
   unsigned char local[bytes];
   std::memcpy(local, &count_, sizeof(Count));
   local[sizeof(Count)] = valid_ ? 1 : 0;
-  int size = 1;
-  MPI_Comm_size(comm, &size);
+  const int size = size_of(comm);
   std::vector<unsigned char> all(bytes * static_cast<std::size_t>(size));
   MPI_Allgather(local, bytes, MPI_BYTE, all.data(), bytes, MPI_BYTE, comm);
   QuantizedSum sum(quantum_);

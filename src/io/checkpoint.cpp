@@ -16,12 +16,6 @@ namespace {
 
 constexpr const char* kFormat = "cosserat checkpoint 1";
 
-int rank_in(MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  return rank;
-}
-
 Handle create_dataset(const hdf5::File& file, const std::string& name, hid_t type,
                       const std::vector<hsize_t>& dims) {
   const std::string what = fmt::format("create dataset {}", name);

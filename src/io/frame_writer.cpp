@@ -50,12 +50,6 @@ std::filesystem::path xmf_path_for(const std::string& h5_path) {
   return std::filesystem::path(h5_path).replace_extension(".xmf");
 }
 
-int rank_in(MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  return rank;
-}
-
 // A dataset of frames: the first dimension is unlimited and grows by one per written frame.
 Handle create_series(const hdf5::File& file, const char* name, hid_t file_type,
                      std::span<const hsize_t> frame_shape, std::span<const hsize_t> chunk) {

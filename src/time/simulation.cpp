@@ -27,22 +27,6 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
   return v;
 }
 
-namespace {
-
-int rank_in(MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
-  return rank;
-}
-
-int size_of(MPI_Comm comm) {
-  int size = 1;
-  MPI_Comm_size(comm, &size);
-  return size;
-}
-
-}  // namespace
-
 Simulation::Simulation(const Scene& scene, MPI_Comm comm)
     : Simulation(scene, comm, Decomposition::choose(scene.m, scene.n, size_of(comm))) {}
 

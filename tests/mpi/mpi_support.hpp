@@ -14,17 +14,8 @@
 
 namespace cosserat::testing {
 
-inline int world_rank() {
-  int rank = 0;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  return rank;
-}
-
-inline int world_size() {
-  int size = 1;
-  MPI_Comm_size(MPI_COMM_WORLD, &size);
-  return size;
-}
+inline int world_rank() { return rank_in(MPI_COMM_WORLD); }
+inline int world_size() { return size_of(MPI_COMM_WORLD); }
 
 inline std::vector<Integrator> all_integrators() {
   std::vector<Integrator> all;

@@ -46,8 +46,7 @@ struct Evaluation {
 };
 
 Evaluation evaluate(const Scene& scene, const Decomposition& d, MPI_Comm comm) {
-  int rank = 0;
-  MPI_Comm_rank(comm, &rank);
+  const int rank = rank_in(comm);
   auto owned = std::make_unique<Block>(d.block(rank, comm));
   const Block& block = *owned;
   Halo halo(d, block, rank);

@@ -12,6 +12,18 @@
 
 namespace cosserat {
 
+// This process's rank in comm, and comm's size.
+inline int rank_in(MPI_Comm comm) {
+  int rank = 0;
+  MPI_Comm_rank(comm, &rank);
+  return rank;
+}
+inline int size_of(MPI_Comm comm) {
+  int size = 1;
+  MPI_Comm_size(comm, &size);
+  return size;
+}
+
 // Ghost width: a node's force reads positions up to two nodes away (MODEL.md §2.4; the
 // derivation is next to the kernel in model/cosserat_model.cpp).
 inline constexpr int kGhostWidth = 2;
