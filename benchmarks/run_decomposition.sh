@@ -11,16 +11,7 @@ cd "$(dirname "$0")/.."
 nodes=${1:-1024}
 steps=${2:-200}
 repeats=${3:-3}
-cmake --preset release >/dev/null
-cmake --build --preset release --target cosserat -j "$(nproc)" >/dev/null
-
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-date=$(date -u +%Y-%m-%d)
-host=$(hostname -s)
-stem=benchmarks/results/decomposition-$host-$date
-cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
-compiler=$(c++ --version | head -1)
-revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+source benchmarks/context.sh decomposition release cosserat
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

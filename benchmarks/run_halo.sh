@@ -6,16 +6,7 @@
 #   benchmarks/run_halo.sh [RANKS...]   (default: 2 4)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake --preset benchmark >/dev/null
-cmake --build --preset benchmark --target bench_halo -j "$(nproc)" >/dev/null
-
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-date=$(date -u +%Y-%m-%d)
-host=$(hostname -s)
-stem=benchmarks/results/halo-$host-$date
-cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
-compiler=$(c++ --version | head -1)
-revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+source benchmarks/context.sh halo benchmark bench_halo
 cores=$(nproc)
 : > "$stem.jsonl"
 for ranks in "${@:-2 4}"; do

@@ -5,16 +5,8 @@
 #   benchmarks/run_throughput.sh [extra Google Benchmark flags]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cmake --preset benchmark >/dev/null
-cmake --build --preset benchmark --target bench_step -j "$(nproc)" >/dev/null
-
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_PROC_BIND=close
-date=$(date -u +%Y-%m-%d)
-host=$(hostname -s)
-stem=benchmarks/results/throughput-$host-$date
-cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
-compiler=$(c++ --version | head -1)
-revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+source benchmarks/context.sh throughput benchmark bench_step
+export OMP_PROC_BIND=close
 
 build/benchmark/benchmarks/bench_step --benchmark_min_time=2 --benchmark_repetitions=3 \
   --benchmark_report_aggregates_only=true \

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "support/dataset_bytes.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -192,24 +194,11 @@ TEST_F(Cli, BlowUpStopsWithItsOwnStatusAndKeepsWork) {
   EXPECT_THAT(json.str(), ::testing::Not(HasSubstr("\"unstable_step\": null")));
 }
 
-// Every dataset of an output file as raw bytes, by name.
+// /positions, /time and /step of an output file as raw bytes.
 std::vector<std::vector<unsigned char>> read_datasets(const std::string& file) {
   std::vector<std::vector<unsigned char>> all;
-  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  if (f < 0) return all;
-  for (const char* name : {"/positions", "/time", "/step"}) {
-    const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
-    const hid_t t = H5Dget_type(d);
-    const hid_t s = H5Dget_space(d);
-    std::vector<unsigned char> bytes(static_cast<std::size_t>(H5Sget_simple_extent_npoints(s)) *
-                                     H5Tget_size(t));
-    H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, bytes.data());
-    all.push_back(std::move(bytes));
-    H5Sclose(s);
-    H5Tclose(t);
-    H5Dclose(d);
-  }
-  H5Fclose(f);
+  for (const char* name : {"/positions", "/time", "/step"})
+    all.push_back(cosserat::testing::dataset_bytes(file, name));
   return all;
 }
 
@@ -230,10 +219,9 @@ TEST_F(Cli, RestartContinuesARunBitwise) {
   // Frames 0, 50, 100, 120 from the first part, 150 and 200 from the second.
   EXPECT_EQ(read_frames(path("part.h5")).first, 6);
   const auto whole = read_datasets(path("whole.h5")), part = read_datasets(path("part.h5"));
-  ASSERT_EQ(whole.size(), 3u);
-  ASSERT_EQ(part.size(), 3u);
   const std::size_t frame_bytes = 6 * 6 * 3 * sizeof(double);
   ASSERT_EQ(part[0].size(), 6 * frame_bytes);
+  ASSERT_EQ(whole[0].size(), 5 * frame_bytes);
   EXPECT_TRUE(std::equal(part[0].end() - frame_bytes, part[0].end(), whole[0].end() - frame_bytes))
       << "the last frames differ";
   std::stringstream json;
@@ -264,8 +252,7 @@ TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
                                     path("killed.checkpoint.h5") + " -o " + path("killed.h5"));
   ASSERT_EQ(restarted.status, 0) << restarted.output;
   const auto whole = read_datasets(path("whole.h5")), killed = read_datasets(path("killed.h5"));
-  ASSERT_EQ(whole.size(), 3u);
-  ASSERT_EQ(killed.size(), 3u);
+  ASSERT_FALSE(whole[0].empty());
   EXPECT_TRUE(killed[0] == whole[0]) << "/positions differ";
   EXPECT_TRUE(killed[1] == whole[1]) << "/time differs";
   EXPECT_TRUE(killed[2] == whole[2]) << "/step differs";

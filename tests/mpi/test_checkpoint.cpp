@@ -6,7 +6,6 @@
 #include <hdf5.h>
 #include <unistd.h>
 
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -14,6 +13,7 @@
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
 #include "mpi_support.hpp"
+#include "support/dataset_bytes.hpp"
 #include "support/sheets.hpp"
 
 namespace cosserat {
@@ -21,6 +21,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::all_integrators;
+using testing::dataset_bytes;
 using testing::all_splits;
 using testing::differing_nodes;
 using testing::world_rank;
@@ -101,21 +102,6 @@ TEST_F(Restart, RefusesACheckpointOfAnotherGridOrStep) {
   Simulation rk4(other_scheme, MPI_COMM_WORLD);
   EXPECT_THROW(read_checkpoint(checkpoint, rk4, other_scheme), CheckpointError);
   EXPECT_THROW(read_checkpoint((folder_ / "missing.h5").string(), sim, other_dt), CheckpointError);
-}
-
-std::vector<unsigned char> dataset_bytes(const std::string& path, const char* name) {
-  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
-  const hid_t dataset = H5Dopen2(file, name, H5P_DEFAULT);
-  const hid_t type = H5Dget_type(dataset);
-  const hid_t space = H5Dget_space(dataset);
-  std::vector<unsigned char> bytes(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)) *
-                                   H5Tget_size(type));
-  H5Dread(dataset, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, bytes.data());
-  H5Sclose(space);
-  H5Tclose(type);
-  H5Dclose(dataset);
-  H5Fclose(file);
-  return bytes;
 }
 
 using Output = SharedFolder;
