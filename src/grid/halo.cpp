@@ -61,9 +61,9 @@ Halo::~Halo() {
 }
 
 void Halo::begin(Field<Vec3>& field) {
-  assert(in_flight_ == nullptr && "one halo exchange at a time");
+  assert(!in_flight_ && "one halo exchange at a time");
   if (neighbours_.empty()) return;
-  in_flight_ = &field;
+  in_flight_ = true;
   started_ = MPI_Wtime();
   // Send and receive regions are disjoint (owned bands, ghost bands), so all transfers of
   // one field may be in flight at once.
@@ -75,7 +75,7 @@ void Halo::begin(Field<Vec3>& field) {
 }
 
 void Halo::end() {
-  if (in_flight_ == nullptr) return;
+  if (!in_flight_) return;
 #ifdef NDEBUG
   MPI_Waitall(static_cast<int>(requests_.size()), requests_.data(), MPI_STATUSES_IGNORE);
 #else
@@ -89,8 +89,7 @@ void Halo::end() {
   }
 #endif
   seconds_ += MPI_Wtime() - started_;
-  ++exchanges_;
-  in_flight_ = nullptr;
+  in_flight_ = false;
 }
 
 }  // namespace cosserat

@@ -36,9 +36,8 @@ class Halo {
     end();
   }
 
-  // Wall time spent in exchange() so far, and the number of calls.
+  // Wall time spent in exchanges so far.
   double seconds() const { return seconds_; }
-  long exchanges() const { return exchanges_; }
 
  private:
   struct Neighbour {
@@ -51,10 +50,9 @@ class Halo {
   MPI_Datatype node_type_;
   std::vector<Neighbour> neighbours_;
   std::vector<MPI_Request> requests_;
-  Field<Vec3>* in_flight_ = nullptr;
+  bool in_flight_ = false;
   double started_ = 0.0;
   double seconds_ = 0.0;
-  long exchanges_ = 0;
 };
 
 }  // namespace cosserat
