@@ -16,13 +16,16 @@
 #include <string>
 #include <vector>
 
+#include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/reduce.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
 #include "cosserat/io/summary.hpp"
+#include "cosserat/model/wave_speed.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/simulation.hpp"
+#include "cosserat/time/stability.hpp"
 
 #if defined(COSSERAT_TRAP_FPE)
 #include <cfenv>
@@ -45,6 +48,17 @@ struct RunOptions {
   std::string summary;
   std::string restart;
   long checkpoint_every = 0;
+  std::optional<double> until_rest;
+  bool quiet = false;
+};
+
+struct StableDtOptions {
+  std::string scene_path;
+  std::vector<std::string> overrides;
+  std::vector<std::string> integrators;
+  std::optional<double> duration;
+  double tolerance = 0.02;
+  std::string csv;
   bool quiet = false;
 };
 
@@ -78,6 +92,13 @@ class Progress {
 };
 
 std::string default_output(const cosserat::Scene& scene) { return scene.name + ".h5"; }
+
+std::string describe(const cosserat::Instability& failure) {
+  if (failure.solver_failure) return *failure.solver_failure;
+  return fmt::format("node [{}, {}] {}", failure.k, failure.l,
+                     failure.not_finite ? "has a non-finite position"
+                                        : "moved more than half a grid spacing in one step");
+}
 
 // Memory of every rank on this node, against the node's physical memory.
 bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, int rank) {
@@ -120,7 +141,15 @@ int run(const RunOptions& options, int rank, int ranks) {
   if (!fits_in_memory(scene, decomposition->block(rank, MPI_COMM_WORLD), rank))
     return kExitBadInput;
 
-  Simulation simulation(scene, MPI_COMM_WORLD, *decomposition);
+  // The semi-implicit baseline checks its solver names with PETSc while it is set up.
+  std::unique_ptr<Simulation> simulation_owner;
+  try {
+    simulation_owner = std::make_unique<Simulation>(scene, MPI_COMM_WORLD, *decomposition);
+  } catch (const SceneError& e) {
+    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadInput;
+  }
+  Simulation& simulation = *simulation_owner;
   std::optional<long> restarted_from;
   if (!options.restart.empty()) {
     try {
@@ -173,15 +202,25 @@ int run(const RunOptions& options, int rank, int ranks) {
   Progress progress(scene.steps, scene.dt, on_terminal);
   const auto start = Clock::now();
   std::optional<Instability> failure;
+  std::optional<RestSummary> rest;
+  if (options.until_rest) rest = RestSummary{*options.until_rest, 0.0, std::nullopt};
   while (simulation.step_index() < scene.steps) {
     failure = simulation.step();
     if (failure) break;
     const long step = simulation.step_index();
-    if (step % scene.output_every == 0 || step == scene.steps) write_frame();
+    bool at_rest = false;
+    if (rest) {
+      const double energy = simulation.diagnostics().kinetic_energy;
+      rest->peak_kinetic_energy = std::max(rest->peak_kinetic_energy, energy);
+      at_rest = energy < rest->fraction * rest->peak_kinetic_energy;
+      if (at_rest) rest->step = step;
+    }
+    if (step % scene.output_every == 0 || step == scene.steps || at_rest) write_frame();
     if (options.checkpoint_every > 0 &&
         (step % options.checkpoint_every == 0 || step == scene.steps))
       write_checkpoint(checkpoint, simulation, scene, COSSERAT_VERSION);
     progress.update(step);
+    if (at_rest) break;
   }
   const double wall = std::chrono::duration<double>(Clock::now() - start).count();
   progress.finish();
@@ -191,12 +230,10 @@ int run(const RunOptions& options, int rank, int ranks) {
     if (writer->last_step() != simulation.step_index()) write_frame();
     if (rank == 0)
       fmt::print(stderr,
-                 "error: unstable at step {} (t = {:.6g} s): node [{}, {}] {}; stopped, the last "
-                 "good state (step {}) is the last frame of {}\n",
-                 failure->step, failure->time, failure->k, failure->l,
-                 failure->not_finite ? "has a non-finite position"
-                                     : "moved more than half a grid spacing in one step",
-                 simulation.step_index(), output);
+                 "error: unstable at step {} (t = {:.6g} s): {}; stopped, the last good state "
+                 "(step {}) is the last frame of {}\n",
+                 failure->step, failure->time, describe(*failure), simulation.step_index(),
+                 output);
     writer->set_attribute("status", fmt::format("unstable at step {}", failure->step));
   } else {
     writer->set_attribute("status", "ok");
@@ -228,6 +265,12 @@ int run(const RunOptions& options, int rank, int ranks) {
   summary.kinetic_energy = diagnostics.kinetic_energy;
   summary.center_of_mass = diagnostics.center_of_mass;
   summary.output = output;
+  if (const auto solves = simulation.stepper().linear_solves()) {
+    summary.linear_solves = LinearSolveSummary{solves->solves, solves->iterations,
+                                               solves->most_iterations, solves->jacobian_seconds,
+                                               solves->solve_seconds};
+  }
+  summary.rest = rest;
   if (rank == 0) {
     if (!options.summary.empty()) write_summary(options.summary, summary);
     if (!options.quiet)
@@ -236,8 +279,102 @@ int run(const RunOptions& options, int rank, int ranks) {
                  steps_run, wall, summary.node_steps_per_second,
                  wall > 0.0 ? 100.0 * summary.halo_seconds / wall : 0.0, summary.area_ratio,
                  summary.status);
+    if (const auto& l = summary.linear_solves)
+      fmt::print("semi-implicit: {:.1f} Krylov iterations per step (most {}); Jacobian {:.3f} s, "
+                 "linear solves {:.3f} s\n",
+                 l->solves > 0 ? static_cast<double>(l->iterations) / l->solves : 0.0,
+                 l->most_iterations, l->jacobian_seconds, l->solve_seconds);
+    if (rest && !options.quiet)
+      fmt::print("{}\n", rest->step ? fmt::format("at rest at step {}", *rest->step)
+                                    : std::string("not at rest by the last step"));
   }
   return failure ? kExitUnstable : kExitOk;
+}
+
+// `cosserat stable-dt`: the largest stable Δt of each integrator, beside the CFL estimate.
+int stable_dt(const StableDtOptions& options, int rank) {
+  using namespace cosserat;
+  std::vector<std::string> integrators = options.integrators;
+  if (integrators.size() == 1 && integrators[0] == "all") integrators = integrator_names();
+  std::vector<Scene> scenes;
+  double duration = 0.0;
+  try {
+    const Scene base = load_scene(options.scene_path, options.overrides);
+    if (integrators.empty()) integrators.push_back(integrator_name(base.integrator));
+    duration = options.duration.value_or(static_cast<double>(base.steps) * base.dt);
+    if (!(duration > 0.0))
+      throw SceneError(fmt::format("{}: the simulated time must be > 0 (give --time T)",
+                                   options.scene_path));
+    for (const std::string& name : integrators) {
+      std::vector<std::string> overrides = options.overrides;
+      overrides.push_back(fmt::format("time.integrator=\"{}\"", name));
+      scenes.push_back(load_scene(options.scene_path, overrides));
+      Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
+    }
+  } catch (const SceneError& e) {
+    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadInput;
+  } catch (const DecompositionError& e) {
+    if (rank == 0) fmt::print(stderr, "error: {}: {}\n", options.scene_path, e.what());
+    return kExitBadInput;
+  }
+
+  const Scene& first = scenes.front();
+  const CflEstimate cfl = cfl_estimate(first);
+  const std::string title = first.title.empty() ? first.name : first.title;
+  if (rank == 0) {
+    fmt::print("{}: {} x {} nodes, stable over T = {} s, to {:.3g} %; CFL estimate {:.4g} s "
+               "(c_L = {:.4g} m/s, c_S = {:.4g} m/s: membrane {:.4g} s, bending {:.4g} s)\n",
+               title, first.m, first.n, duration, 100.0 * options.tolerance, cfl.dt,
+               cfl.longitudinal_speed, cfl.shear_speed, cfl.membrane_dt, cfl.bending_dt);
+    fmt::print("{:<17} {:>12} {:>12} {:>7} {:>7} {:>9}  {}\n", "integrator", "stable dt",
+               "unstable dt", "/ CFL", "trials", "wall s", "first unstable trial");
+  }
+  std::string csv =
+      "scene,integrator,duration,stable_dt,unstable_dt,cfl_dt,stable_over_cfl,trials,"
+      "wall_seconds,cause\n";
+  for (const Scene& scene : scenes) {
+    const std::string name = integrator_name(scene.integrator);
+    StableStep found;
+    try {
+      found = largest_stable_step(scene, duration, options.tolerance, MPI_COMM_WORLD,
+                                  [&](const StabilityTrial& t) {
+                                    if (rank == 0 && !options.quiet)
+                                      fmt::print(stderr, "  {} dt = {:.6g}: {}\n", name, t.dt,
+                                                 t.stable ? "stable" : "unstable, " + t.cause);
+                                  });
+    } catch (const SceneError& e) {
+      if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
+      return kExitBadInput;
+    }
+    double wall = 0.0;
+    std::string cause;
+    for (const StabilityTrial& t : found.trials) {
+      wall += t.wall_seconds;
+      if (!t.stable && t.dt == found.unstable_dt) cause = t.cause;
+    }
+    if (found.unstable_dt == 0.0) cause = fmt::format("stable up to dt = T = {} s", duration);
+    if (found.stable_dt == 0.0) cause = "no stable step down to 1e-6 of the scene's dt; " + cause;
+    if (rank == 0) {
+      fmt::print("{:<17} {:>12.6g} {:>12.6g} {:>7.3f} {:>7} {:>9.2f}  {}\n", name,
+                 found.stable_dt, found.unstable_dt, found.stable_dt / cfl.dt,
+                 found.trials.size(), wall, cause);
+      std::fflush(stdout);
+    }
+    csv += fmt::format("\"{}\",{},{},{},{},{},{},{},{},\"{}\"\n", title, name, duration,
+                       found.stable_dt, found.unstable_dt, cfl.dt, found.stable_dt / cfl.dt,
+                       found.trials.size(), wall, cause);
+  }
+  if (rank == 0 && !options.csv.empty()) {
+    std::FILE* file = std::fopen(options.csv.c_str(), "w");
+    if (file == nullptr) {
+      fmt::print(stderr, "error: cannot write {}\n", options.csv);
+      return kExitFailure;
+    }
+    std::fputs(csv.c_str(), file);
+    std::fclose(file);
+  }
+  return kExitOk;
 }
 
 }  // namespace
@@ -256,6 +393,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("cosserat ") + COSSERAT_VERSION);
   app.require_subcommand(1);
   RunOptions options;
+  std::string petsc_options;
   CLI::App* run_command = app.add_subcommand("run", "Run a scene and write its frames to HDF5 + XDMF");
   run_command->add_option("scene", options.scene_path, "Scene file (TOML, see docs/scene-format.md)")
       ->required();
@@ -279,6 +417,14 @@ int main(int argc, char** argv) {
                           "uninterrupted run bitwise. The output file, if present, keeps its "
                           "frames up to the checkpoint and is continued")
       ->check(CLI::ExistingFile);
+  run_command->add_option("--until-rest", options.until_rest,
+                          "Stop once the kinetic energy is below this fraction of its peak so "
+                          "far (e.g. 1e-6); the summary's \"rest\" gives the step")
+      ->check(CLI::Range(0.0, 1.0));
+  run_command->add_option("--petsc", petsc_options,
+                          "PETSc options for the semi-implicit integrator, in one string "
+                          "(e.g. \"-ksp_type cg -pc_type jacobi -ksp_rtol 1e-8\"); they override "
+                          "the scene's [time.solver]. PETSC_OPTIONS is read too");
   run_command->add_flag("-q,--quiet", options.quiet,
                         "Print nothing but warnings and errors (the progress line is shown "
                         "only on a terminal anyway)");
@@ -286,6 +432,36 @@ int main(int argc, char** argv) {
       "Threads: OMP_NUM_THREADS (default: all cores). On a terminal a progress line shows the "
       "step, simulated time, steps/s and ETA. Ranks: mpirun -np P splits the grid into P "
       "blocks (see jobs/README.md).");
+
+  StableDtOptions stable;
+  CLI::App* stable_command = app.add_subcommand(
+      "stable-dt",
+      "Largest stable time step of a scene per integrator, by bisection on the stability "
+      "monitor (MODEL.md §4.2), beside the CFL estimate from the model's wave speeds");
+  stable_command->add_option("scene", stable.scene_path, "Scene file (TOML)")->required();
+  stable_command->add_option("--integrator", stable.integrators,
+                             "Integrator to test (repeatable; \"all\" for every one; default: "
+                             "the scene's)");
+  stable_command->add_option("--time", stable.duration,
+                             "Simulated time T each trial must survive (s; default: the "
+                             "scene's steps x dt)")
+      ->check(CLI::PositiveNumber);
+  stable_command->add_option("--tolerance", stable.tolerance,
+                             "Stop when the stable and unstable steps are within this fraction "
+                             "(default 0.02)")
+      ->check(CLI::Range(1e-6, 1.0));
+  stable_command->add_option("--set", stable.overrides,
+                             "Override a scene key, as for run (repeatable)")
+      ->allow_extra_args(false);
+  stable_command->add_option("--csv", stable.csv, "Also write the table as CSV to this file");
+  stable_command->add_option("--petsc", petsc_options,
+                             "PETSc options for the semi-implicit integrator, as for run");
+  stable_command->add_flag("-q,--quiet", stable.quiet, "No line per trial on stderr");
+  stable_command->footer(
+      "Each trial runs the scene for ceil(T/dt) steps without output. Steps start from the "
+      "scene's dt, double or halve to bracket the limit, then bisect. Threads and ranks as for "
+      "run.");
+
   app.footer(
       "Exit status: 0 ok, 2 bad input (nothing was run), 3 the run became unstable (frames so "
       "far and the last good state are kept), 1 anything else.");
@@ -293,16 +469,22 @@ int main(int argc, char** argv) {
   int status = kExitOk;
   try {
     app.parse(argc, argv);
-    status = run(options, rank, ranks);
+    if (!petsc_options.empty()) cosserat::add_petsc_options(petsc_options);
+    status = *run_command ? run(options, rank, ranks) : stable_dt(stable, rank);
   } catch (const CLI::Success& e) {
     status = app.exit(e);
   } catch (const CLI::ParseError& e) {
     app.exit(e);
     status = kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    // --petsc on a build without PETSc
+    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
+    status = kExitBadInput;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
     status = kExitFailure;
   }
+  cosserat::finalize_petsc();
   MPI_Finalize();
   return status;
 }

@@ -22,6 +22,12 @@ std::vector<int> cuts(int size, int parts) {
 // neighbours: the halo exchange reads ghosts from the adjacent block only.
 bool fits(int size, int parts) { return parts == 1 || size / parts >= kGhostWidth; }
 
+std::vector<int> widths(const std::vector<int>& cuts) {
+  std::vector<int> w;
+  for (std::size_t i = 0; i + 1 < cuts.size(); ++i) w.push_back(cuts[i + 1] - cuts[i]);
+  return w;
+}
+
 }  // namespace
 
 Decomposition::Decomposition(int m, int n, int parts_k, int parts_l)
@@ -64,6 +70,9 @@ Block Decomposition::block(int rank, MPI_Comm comm) const {
   const auto j = static_cast<std::size_t>(rank / parts_k());
   return Block{comm, m_, n_, k_cuts_[i], k_cuts_[i + 1], l_cuts_[j], l_cuts_[j + 1], kGhostWidth};
 }
+
+std::vector<int> Decomposition::widths_k() const { return widths(k_cuts_); }
+std::vector<int> Decomposition::widths_l() const { return widths(l_cuts_); }
 
 int Decomposition::rank_of(int i, int j) const {
   if (i < 0 || i >= parts_k() || j < 0 || j >= parts_l()) return MPI_PROC_NULL;

@@ -48,6 +48,21 @@ std::string to_json(const RunSummary& s) {
   const std::string restarted_from =
       s.restarted_from ? fmt::format("{}", *s.restarted_from) : "null";
   const Vec3& com = s.center_of_mass;
+  std::string linear_solves = "null";
+  if (const auto& l = s.linear_solves) {
+    linear_solves = fmt::format(
+        R"({{"solves": {}, "iterations": {}, "mean_iterations": {}, "most_iterations": {}, )"
+        R"("jacobian_seconds": {}, "solve_seconds": {}}})",
+        l->solves, l->iterations,
+        json_number(l->solves > 0 ? static_cast<double>(l->iterations) / l->solves : 0.0),
+        l->most_iterations, json_number(l->jacobian_seconds), json_number(l->solve_seconds));
+  }
+  std::string rest = "null";
+  if (const auto& r = s.rest) {
+    rest = fmt::format(R"({{"fraction": {}, "peak_kinetic_energy": {}, "step": {}}})",
+                       json_number(r->fraction), json_number(r->peak_kinetic_energy),
+                       r->step ? fmt::format("{}", *r->step) : "null");
+  }
   return fmt::format(
       R"({{
   "scene": {},
@@ -69,7 +84,9 @@ std::string to_json(const RunSummary& s) {
   "max_speed": {},
   "kinetic_energy": {},
   "center_of_mass": [{}, {}, {}],
-  "output": {}
+  "output": {},
+  "linear_solves": {},
+  "rest": {}
 }}
 )",
       json_string(s.scene), s.m, s.n, s.ranks, s.threads, s.parts_k, s.parts_l,
@@ -77,7 +94,7 @@ std::string to_json(const RunSummary& s) {
       json_number(s.wall_seconds), json_number(s.node_steps_per_second),
       json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,
       json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
-      json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output));
+      json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest);
 }
 
 void write_summary(const std::string& path, const RunSummary& summary) {

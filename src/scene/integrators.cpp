@@ -11,7 +11,7 @@ const std::vector<std::string>& integrator_names() {
   // Indexed by the enum's value: keep the two in the same order.
   static const std::vector<std::string> names{
       "verlet",   "symplectic-euler", "euler",     "midpoint",      "rk4",
-      "leapfrog", "velocity-verlet",  "tc-verlet", "verlet-lagged",
+      "leapfrog", "velocity-verlet",  "tc-verlet", "verlet-lagged", "semi-implicit",
   };
   return names;
 }

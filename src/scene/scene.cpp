@@ -467,8 +467,23 @@ void read_environment(const Table& environment, Scene& scene) {
   if (const auto fluid = environment.find_table("fluid")) scene.fluid = read_fluid(*fluid);
 }
 
+LinearSolver read_solver(const Table& solver) {
+  solver.allow({"ksp", "pc", "rtol", "atol", "max_iterations"});
+  LinearSolver linear;
+  // The names are PETSc's (gmres, cg, bcgs, ...; bjacobi, jacobi, gamg, none, ...); PETSc checks
+  // them when the solver is set up, before the first step.
+  if (const auto ksp = solver.find("ksp")) linear.ksp = ksp->string();
+  if (const auto pc = solver.find("pc")) linear.pc = pc->string();
+  if (const auto rtol = solver.find("rtol")) linear.rtol = positive(*rtol);
+  if (const auto atol = solver.find("atol")) linear.atol = positive(*atol);
+  if (const auto iterations = solver.find("max_iterations")) {
+    linear.max_iterations = integer_at_least(*iterations, 1);
+  }
+  return linear;
+}
+
 void read_time(const Table& time, Scene& scene) {
-  time.allow({"integrator", "dt", "steps", "output_every"});
+  time.allow({"integrator", "dt", "steps", "output_every", "solver"});
   if (const auto field = time.find("integrator")) {
     const std::string name = field->string();
     const auto integrator = integrator_from_name(name);
@@ -476,7 +491,23 @@ void read_time(const Table& time, Scene& scene) {
       field->fail(
           fmt::format("unknown integrator \"{}\"; allowed: {}", name, joined(integrator_names())));
     }
+#ifndef COSSERAT_HAVE_PETSC
+    if (*integrator == Integrator::semi_implicit) {
+      field->fail(
+          "the semi-implicit integrator is the PETSc baseline, and this build has no PETSc "
+          "(install libpetsc-real-dev and configure with -DCOSSERAT_WITH_PETSC=ON)");
+    }
+#endif
     scene.integrator = *integrator;
+  }
+  if (const auto solver = time.find_table("solver")) {
+    scene.solver = read_solver(*solver);
+    // A sweep over integrators keeps the table; only the semi-implicit one reads it.
+    if (scene.integrator != Integrator::semi_implicit) {
+      scene.warnings.push_back(
+          "[time.solver] is read by the semi-implicit integrator only; ignored for " +
+          integrator_name(scene.integrator));
+    }
   }
   scene.dt = positive(time.require("dt", "a number > 0 (seconds)"));
   scene.steps = integer_at_least(time.require("steps", "an integer >= 0"), 0);

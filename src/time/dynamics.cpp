@@ -58,6 +58,15 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
   return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
 }
 
+void Dynamics::internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a) {
+  const Block& b = *block_;
+  model_.internal_force(r, a);
+  const double internal_scale = rest_area_ / mass_;
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l);
+}
+
 void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step,
                             Field<Vec3>& a) {
   const VelocityTerms terms = free_acceleration(r, step, a);

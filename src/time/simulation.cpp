@@ -36,7 +36,7 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
       block_(decomposition_.block(rank_in(comm), comm)),
       halo_(decomposition_, block_, rank_in(comm)),
       dynamics_(scene, block_, rest_positions(scene, block_)),
-      stepper_(scene, block_, halo_, dynamics_, rest_positions(scene, block_),
+      stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),
                initial_velocities(scene, block_)) {}
 
 double Simulation::memory_bytes(const Block& block) {

@@ -23,15 +23,17 @@ inline Vec3 solve_centred(const Vec3& rhs, const Vec3& n, double c, double d) {
   return (rhs - (d / (1.0 + c + d) * dot(n, rhs)) * n) / (1.0 + c);
 }
 
+// The schemes whose state is (r, r⁻): the semi-implicit step is Verlet's with J added.
 bool is_verlet_family(Integrator s) {
   return s == Integrator::verlet || s == Integrator::tc_verlet ||
-         s == Integrator::verlet_lagged;
+         s == Integrator::verlet_lagged || s == Integrator::semi_implicit;
 }
 
 }  // namespace
 
-Stepper::Stepper(const Scene& scene, const Block& block, Halo& halo, Dynamics& dynamics,
-                 const Field<Vec3>& positions, const Field<Vec3>& velocities)
+Stepper::Stepper(const Scene& scene, const Decomposition& decomposition, const Block& block,
+                 Halo& halo, Dynamics& dynamics, const Field<Vec3>& positions,
+                 const Field<Vec3>& velocities)
     : block_(&block),
       halo_(&halo),
       dynamics_(&dynamics),
@@ -44,6 +46,8 @@ Stepper::Stepper(const Scene& scene, const Block& block, Halo& halo, Dynamics& d
       v_(velocities),
       r_next_(block),
       a_(block) {
+  if (scheme_ == Integrator::semi_implicit)
+    implicit_ = std::make_unique<SemiImplicitSolver>(scene, decomposition, block, dynamics);
   start();
 }
 
@@ -63,9 +67,14 @@ void Stepper::start() {
   switch (scheme_) {
     case Integrator::verlet:
     case Integrator::tc_verlet:
-    case Integrator::verlet_lagged: {
+    case Integrator::verlet_lagged:
+    case Integrator::semi_implicit: {
       r_prev_ = Field<Vec3>(b);
       v_report_ = Field<Vec3>(b);
+      if (scheme_ == Integrator::semi_implicit) {
+        r_stage_ = Field<Vec3>(b);  // d = rⁿ − rⁿ⁻¹
+        v_stage_ = Field<Vec3>(b);  // δ = rⁿ⁺¹ − rⁿ
+      }
       if (scheme_ == Integrator::verlet_lagged) {
         // The published start: first order.
         for_owned(b, [&](int k, int l) { r_prev_(k, l) = r_(k, l) - dt * v_(k, l); });
@@ -121,6 +130,12 @@ std::optional<Instability> Stepper::step() {
     case Integrator::midpoint: midpoint_step(); break;
     case Integrator::rk4: rk4_step(); break;
     case Integrator::velocity_verlet: velocity_verlet_step(); break;
+    case Integrator::semi_implicit:
+      if (auto solver_failure = semi_implicit_step()) {
+        return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, -1, -1, false,
+                           std::move(solver_failure)};
+      }
+      break;
   }
   if (auto failure = check(r_next_)) return failure;
 
@@ -129,6 +144,7 @@ std::optional<Instability> Stepper::step() {
     case Integrator::verlet:
     case Integrator::tc_verlet:
     case Integrator::verlet_lagged:
+    case Integrator::semi_implicit:
       r_prev_.swap(r_);
       dt_previous_ = dt_;
       break;
@@ -288,6 +304,38 @@ void Stepper::velocity_verlet_step() {
   constraints_.hold_velocities(v_sum_);
 }
 
+// The linearly implicit central-difference step (docs/semi-implicit.md): Verlet's update with
+// the velocity terms at the centre and the internal force linearised about rⁿ,
+// f_int(rⁿ⁺¹) ≈ f_int(rⁿ) + J δ, per unit mass:
+//   [(1/Δt² + D/(2Δt)) I + F/(2Δt) n nᵀ − J] δ = a(rⁿ) + (1/Δt² − D/(2Δt)) d − F/(2Δt) (n·d) n
+// with d = rⁿ − rⁿ⁻¹, δ = rⁿ⁺¹ − rⁿ. With J = 0 it is verlet_step's closed form.
+std::optional<std::string> Stepper::semi_implicit_step() {
+  constraints_.hold_positions(r_prev_);
+  Field<Vec3>& d = r_stage_;
+  Field<Vec3>& delta = v_stage_;
+  implicit_->linearise(r_);
+  // After the Jacobian, whose evaluations moved the normals the fluid terms read at rⁿ.
+  const VelocityTerms terms = dynamics_->free_acceleration(r_, step_, a_);
+  const double dt = dt_;
+  const double lag = 1.0 / (dt * dt) - terms.damping / (2.0 * dt);
+  const double fluid = terms.fluid / (2.0 * dt);
+  Field<Vec3>& rhs = a_;
+  for_owned(*block_, [&](int k, int l) {
+    const Vec3 dk = r_(k, l) - r_prev_(k, l);
+    d(k, l) = dk;
+    Vec3 b = a_(k, l) + lag * dk;
+    if (fluid > 0.0) {
+      const Vec3 n = dynamics_->normal(k, l);
+      b -= (fluid * dot(n, dk)) * n;
+    }
+    rhs(k, l) = b;
+  });
+  if (auto failure = implicit_->solve(terms, rhs, d, constraints_.state(), delta)) return failure;
+  for_owned(*block_, [&](int k, int l) { r_next_(k, l) = r_(k, l) + delta(k, l); });
+  constraints_.hold_positions(r_next_);
+  return std::nullopt;
+}
+
 // MODEL.md §4.2: a position that is not finite, or a node that moved more than half a grid
 // spacing. The first such node in (l, k) order is reported, the same for any thread count.
 std::optional<Instability> Stepper::check(const Field<Vec3>& next) const {
@@ -326,7 +374,7 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next) const {
   int any_reason = reason;
   MPI_Allreduce(&reason, &any_reason, 1, MPI_INT, MPI_MAX, b.comm);
   return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, static_cast<int>(global % b.m),
-                     static_cast<int>(global / b.m), any_reason != 0};
+                     static_cast<int>(global / b.m), any_reason != 0, std::nullopt};
 }
 
 std::vector<Stepper::StateField> Stepper::state_fields() {
@@ -345,6 +393,11 @@ void Stepper::resume(long step) {
   time_ = static_cast<double>(step_) * dt_;
   velocities_current_ = false;
   halo_->exchange(r_);
+}
+
+std::optional<LinearSolveStats> Stepper::linear_solves() const {
+  if (!implicit_) return std::nullopt;
+  return implicit_->stats();
 }
 
 const Field<Vec3>& Stepper::velocities() {

@@ -20,7 +20,7 @@ namespace cosserat {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::all_integrators;
+using testing::explicit_integrators;
 using testing::dataset_bytes;
 using testing::all_splits;
 using testing::differing_nodes;
@@ -51,7 +51,7 @@ using Restart = SharedFolder;
 
 TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
   const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
-  for (const Integrator integrator : all_integrators()) {
+  for (const Integrator integrator : explicit_integrators()) {
     const Scene scene = testing::odd_grid_scene(integrator);  // 80 steps
     const long half = scene.steps / 2;
     const auto splits = all_splits(scene.m, scene.n, world_size());

@@ -18,7 +18,7 @@
 namespace cosserat {
 namespace {
 
-using testing::all_integrators;
+using testing::explicit_integrators;
 using testing::all_splits;
 using testing::differing_nodes;
 using testing::split_name;
@@ -97,7 +97,7 @@ TEST(DecompositionInvariance, WithoutTheHaloTheBorderForcesDiffer) {
 // The whole trajectory, every integrator, every split: positions and velocities after 80 steps
 // (through a load window ending and a fix switching on) equal the one-block run's.
 TEST(DecompositionInvariance, EveryIntegratorFollowsTheOneBlockTrajectory) {
-  for (const Integrator integrator : all_integrators()) {
+  for (const Integrator integrator : explicit_integrators()) {
     const Scene scene = testing::odd_grid_scene(integrator);
     Simulation reference(scene, MPI_COMM_SELF);
     ASSERT_TRUE(testing::advance(reference, scene.steps));

@@ -39,7 +39,10 @@ TEST_P(EveryScheme, FreeFall) {
       const Vec3 start = (k * scene.h1()) * scene.u + (l * scene.h2()) * scene.v;
       worst = std::max(worst, norm(sim.positions()(k, l) - (start + shift)));
     }
-  EXPECT_LT(worst, 1e-9) << "t = " << t;
+  // The semi-implicit step adds J δ, zero for a rigid δ only up to the finite-difference
+  // Jacobian's error, about sqrt(eps) of its entries.
+  const double tolerance = scene.integrator == Integrator::semi_implicit ? 1e-7 : 1e-9;
+  EXPECT_LT(worst, tolerance) << "t = " << t;
 }
 
 // Final positions of a smooth scene: an 8 x 8 sheet hanging from one corner, with damping
@@ -71,7 +74,10 @@ int expected_order(Integrator s) {
   switch (s) {
     case Integrator::euler:
     case Integrator::symplectic_euler:
-    case Integrator::verlet_lagged: return 1;
+    case Integrator::verlet_lagged:
+    // The force is taken at the new positions, linearised (docs/semi-implicit.md): J δ is an
+    // O(Δt) change of the force, so the scheme the issue specifies is first order.
+    case Integrator::semi_implicit: return 1;
     case Integrator::rk4: return 4;
     default: return 2;
   }
@@ -94,12 +100,20 @@ TEST_P(EveryScheme, ConvergenceOrder) {
   EXPECT_NEAR(observed, order, 0.3);
 }
 
-INSTANTIATE_TEST_SUITE_P(Integrators, EveryScheme,
-                         ::testing::Values(Integrator::verlet, Integrator::symplectic_euler,
-                                           Integrator::euler, Integrator::midpoint,
-                                           Integrator::rk4, Integrator::leapfrog,
-                                           Integrator::velocity_verlet, Integrator::tc_verlet,
-                                           Integrator::verlet_lagged),
+// Every scheme of the build: the semi-implicit one exists only with PETSc.
+std::vector<Integrator> every_scheme() {
+  std::vector<Integrator> schemes;
+  for (const std::string& name : integrator_names()) {
+    const Integrator scheme = *integrator_from_name(name);
+#if !defined(COSSERAT_HAVE_PETSC)
+    if (scheme == Integrator::semi_implicit) continue;
+#endif
+    schemes.push_back(scheme);
+  }
+  return schemes;
+}
+
+INSTANTIATE_TEST_SUITE_P(Integrators, EveryScheme, ::testing::ValuesIn(every_scheme()),
                          testing::scheme_test_name);
 
 }  // namespace

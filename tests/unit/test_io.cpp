@@ -272,13 +272,28 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
       "wall_seconds",  "node_steps_per_second",           "halo_seconds",
       "restarted_from", "status",
       "unstable_step", "area_ratio",    "max_speed",      "kinetic_energy",
-      "center_of_mass", "output"};
+      "center_of_mass", "output",        "linear_solves",  "rest"};
   EXPECT_EQ(keys, expected);
+  EXPECT_NE(json.find(R"("linear_solves": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("grid": [32, 48])"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("restarted_from": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("dt": 0.0001,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("center_of_mass": [0.5, -0.25, 0])"), std::string::npos) << json;
   EXPECT_EQ(json.front(), '{');
+}
+
+// The semi-implicit integrator's solves and --until-rest's result, as objects.
+TEST(RunSummaryTest, WritesLinearSolvesAndRest) {
+  RunSummary summary = example_summary();
+  summary.linear_solves = LinearSolveSummary{10, 25, 4, 0.5, 0.25};
+  summary.rest = RestSummary{1e-6, 2.0, 840};
+  const std::string json = to_json(summary);
+  EXPECT_NE(json.find(R"("linear_solves": {"solves": 10, "iterations": 25, "mean_iterations": 2.5, "most_iterations": 4, "jacobian_seconds": 0.5, "solve_seconds": 0.25},)"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find(R"("rest": {"fraction": 1e-06, "peak_kinetic_energy": 2, "step": 840})"),
+            std::string::npos)
+      << json;
 }
 
 TEST(RunSummaryTest, WritesNullForMissingAndNonFiniteValues) {

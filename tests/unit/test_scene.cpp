@@ -212,12 +212,40 @@ TEST(Scene, PresetTableIsThePublishedOne) {
 
 TEST(Scene, IntegratorNamesFollowTheEnum) {
   const auto& names = integrator_names();
-  ASSERT_EQ(names.size(), 9u);
+  ASSERT_EQ(names.size(), 10u);
   EXPECT_EQ(names.front(), "verlet");
-  EXPECT_EQ(names.back(), "verlet-lagged");
+  EXPECT_EQ(names.back(), "semi-implicit");
   for (const auto& name : names) EXPECT_EQ(integrator_name(*integrator_from_name(name)), name);
   EXPECT_EQ(integrator_from_name("tc-verlet"), Integrator::tc_verlet);
   EXPECT_FALSE(integrator_from_name("Verlet").has_value());
+}
+
+// [time.solver]: PETSc names and tolerances for the semi-implicit integrator.
+TEST(Scene, SolverTable) {
+  SceneText text;
+  text.time += "integrator = \"semi-implicit\"\n";
+  text.tail = "[time.solver]\nksp = \"cg\"\npc = \"jacobi\"\nrtol = 1e-8\nmax_iterations = 50\n";
+#if defined(COSSERAT_HAVE_PETSC)
+  const Scene scene = parse(text);
+  EXPECT_EQ(scene.solver.ksp, "cg");
+  EXPECT_EQ(scene.solver.pc, "jacobi");
+  EXPECT_EQ(scene.solver.rtol, 1e-8);
+  EXPECT_EQ(scene.solver.atol, LinearSolver{}.atol);
+  EXPECT_EQ(scene.solver.max_iterations, 50);
+  EXPECT_TRUE(scene.warnings.empty());
+  // Read by the semi-implicit integrator only: with another, a warning, not an error.
+  const Scene explicit_scene = parse(text, {"time.integrator=verlet"});
+  ASSERT_EQ(explicit_scene.warnings.size(), 1u);
+  EXPECT_THAT(explicit_scene.warnings[0], HasSubstr("[time.solver]"));
+#else
+  EXPECT_THAT(error_of(text), HasSubstr("PETSc"));
+#endif
+  text.tail = "[time.solver]\nrtol = 0.0\n";
+  EXPECT_THAT(error_of(text, {"time.integrator=verlet"}),
+              AllOf(HasSubstr("time.solver.rtol"), HasSubstr("> 0")));
+  text.tail = "[time.solver]\ntolerance = 1e-8\n";
+  EXPECT_THAT(error_of(text, {"time.integrator=verlet"}),
+              AllOf(HasSubstr("time.solver.tolerance"), HasSubstr("allowed here")));
 }
 
 TEST(Scene, RegionsExpandToGridNodes) {

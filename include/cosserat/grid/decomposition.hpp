@@ -33,6 +33,10 @@ class Decomposition {
   int parts_l() const { return static_cast<int>(l_cuts_.size()) - 1; }
   int ranks() const { return parts_k() * parts_l(); }
 
+  // Nodes per block along k (one entry per part) and along l: PETSc's DMDA ownership ranges.
+  std::vector<int> widths_k() const;
+  std::vector<int> widths_l() const;
+
   // The block of `rank`; the communicator must have ranks() ranks.
   Block block(int rank, MPI_Comm comm) const;
 

@@ -9,6 +9,22 @@
 
 namespace cosserat {
 
+// The semi-implicit baseline's linear solves over the run (rank 0's timings).
+struct LinearSolveSummary {
+  long solves = 0;
+  long iterations = 0;
+  long most_iterations = 0;
+  double jacobian_seconds = 0.0;
+  double solve_seconds = 0.0;
+};
+
+// When a run stopped at rest (--until-rest): kinetic energy below `fraction` of its peak.
+struct RestSummary {
+  double fraction = 0.0;
+  double peak_kinetic_energy = 0.0;
+  std::optional<long> step;  // the first step at rest; empty if the run ended before
+};
+
 struct RunSummary {
   std::string scene;
   int m = 0;
@@ -31,6 +47,8 @@ struct RunSummary {
   double kinetic_energy = 0.0;
   Vec3 center_of_mass;
   std::string output;  // the HDF5 file written
+  std::optional<LinearSolveSummary> linear_solves;  // semi-implicit only
+  std::optional<RestSummary> rest;                  // with --until-rest only
 };
 
 // Non-finite numbers and an empty unstable_step are written as null, since JSON has no NaN.

@@ -30,6 +30,7 @@ enum class Integrator {
   velocity_verlet,
   tc_verlet,
   verlet_lagged,
+  semi_implicit,  // the PETSc baseline; only in builds with PETSc
 };
 
 // Names as written in scene files, in the order of the enum.
@@ -71,6 +72,16 @@ struct Fluid {
   Vec3 velocity;           // u
 };
 
+// [time.solver]: the linear solver of the semi-implicit integrator, in PETSc's names. PETSc's
+// own -ksp_* and -pc_* options (command line or PETSC_OPTIONS) override these.
+struct LinearSolver {
+  std::string ksp = "gmres";
+  std::string pc = "bjacobi";  // block Jacobi with ILU(0) blocks: one block per rank
+  double rtol = 1e-10;
+  double atol = 1e-50;  // PETSc's default: the relative test decides
+  long max_iterations = 1000;
+};
+
 struct Scene {
   std::string path;   // the file it came from
   std::string text;   // the scene text as read
@@ -104,6 +115,7 @@ struct Scene {
   double dt = 0.0;
   long steps = 0;
   long output_every = 1;  // write a frame every N steps (the last step always)
+  LinearSolver solver;
 
   std::vector<Fix> fixes;
   std::vector<Load> loads;

@@ -26,6 +26,11 @@ class Dynamics {
   // the velocity terms, for schemes that treat those at the step's centre.
   VelocityTerms free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a);
 
+  // The internal force's share of the acceleration, f_int/μ, into `a`: independent of S
+  // (MODEL.md §3), so a function of the positions alone. The semi-implicit baseline
+  // differentiates it. Overwrites the normals that normal() reports.
+  void internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a);
+
   // The whole acceleration A(r, v) at `step`.
   void acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step, Field<Vec3>& a);
 

@@ -1,0 +1,45 @@
+#pragma once
+// The largest stable step of a scene and integrator, by bisection on the
+// stability monitor of MODEL.md §4.2 (SCENES.md: "never by eye"): the engine of
+// `cosserat stable-dt`.
+
+#include <mpi.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "cosserat/scene/scene.hpp"
+
+namespace cosserat {
+
+// One run of the scene at step dt over ceil(duration/dt) steps, without output.
+struct StabilityTrial {
+  double dt = 0.0;
+  long steps = 0;      // steps run (the failing one not counted)
+  bool stable = false; // the monitor never stopped it
+  std::string cause;   // what stopped it, when it was stopped
+  double wall_seconds = 0.0;
+};
+
+StabilityTrial run_trial(const Scene &scene, double dt, double duration,
+                         MPI_Comm comm);
+
+struct StableStep {
+  double stable_dt =
+      0.0; // the largest step found stable (0: none, down to the floor)
+  double unstable_dt =
+      0.0; // the smallest found unstable (0: none, up to the ceiling)
+  std::vector<StabilityTrial> trials;
+};
+
+// Starting from the scene's dt, doubles or halves until stable and unstable
+// steps bracket the limit, then bisects until they are within `tolerance` of
+// each other (relative to the stable one). Steps above `duration` or below 1e-6
+// of the scene's dt end the search unbracketed. `report` sees every trial as it
+// ends (rank 0 prints progress with it).
+StableStep largest_stable_step(
+    const Scene &scene, double duration, double tolerance, MPI_Comm comm,
+    const std::function<void(const StabilityTrial &)> &report = {});
+
+} // namespace cosserat

@@ -1,0 +1,88 @@
+#include "cosserat/time/stability.hpp"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "cosserat/time/simulation.hpp"
+
+namespace cosserat {
+
+StabilityTrial run_trial(const Scene &scene, double dt, double duration,
+                         MPI_Comm comm) {
+  Scene trial_scene = scene;
+  trial_scene.dt = dt;
+  trial_scene.steps = static_cast<long>(std::ceil(duration / dt - 1e-9));
+  const auto start = std::chrono::steady_clock::now();
+  Simulation simulation(trial_scene, comm);
+  StabilityTrial trial;
+  trial.dt = dt;
+  trial.stable = true;
+  while (simulation.step_index() < trial_scene.steps) {
+    if (const auto failure = simulation.step()) {
+      trial.stable = false;
+      trial.cause =
+          failure->solver_failure
+              ? fmt::format("step {}: {}", failure->step,
+                            *failure->solver_failure)
+              : fmt::format("step {}: node [{}, {}] {}", failure->step,
+                            failure->k, failure->l,
+                            failure->not_finite ? "not finite" : "moved > h/2");
+      break;
+    }
+  }
+  trial.steps = simulation.step_index();
+  trial.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+          .count();
+  return trial;
+}
+
+StableStep
+largest_stable_step(const Scene &scene, double duration, double tolerance,
+                    MPI_Comm comm,
+                    const std::function<void(const StabilityTrial &)> &report) {
+  StableStep result;
+  auto trial = [&](double dt) {
+    result.trials.push_back(run_trial(scene, dt, duration, comm));
+    if (report)
+      report(result.trials.back());
+    return result.trials.back().stable;
+  };
+  const double floor = 1e-6 * scene.dt;
+  double dt = scene.dt;
+  if (trial(dt)) {
+    result.stable_dt = dt;
+    while (result.unstable_dt == 0.0) {
+      dt *= 2.0;
+      if (dt > duration)
+        return result;
+      if (trial(dt))
+        result.stable_dt = dt;
+      else
+        result.unstable_dt = dt;
+    }
+  } else {
+    result.unstable_dt = dt;
+    while (result.stable_dt == 0.0) {
+      dt *= 0.5;
+      if (dt < floor)
+        return result;
+      if (trial(dt))
+        result.stable_dt = dt;
+      else
+        result.unstable_dt = dt;
+    }
+  }
+  while (result.unstable_dt - result.stable_dt > tolerance * result.stable_dt) {
+    const double middle = 0.5 * (result.stable_dt + result.unstable_dt);
+    if (trial(middle))
+      result.stable_dt = middle;
+    else
+      result.unstable_dt = middle;
+  }
+  return result;
+}
+
+} // namespace cosserat
