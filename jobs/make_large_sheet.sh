@@ -2,8 +2,9 @@
 # Writes an S1-like scene (SCENES.md S1: the 10 m x 10 m, 10 kg reference sheet hung from the
 # two corners of one edge, gravity, damping 0.2, Verlet) on a NODES x NODES grid to FILE.
 # S1's own file names its corners by index for its 10 x 10 grid; here they follow NODES. The
-# step is 0.02 h²: the largest stable Verlet step shrinks with h² (MODEL.md §4.2), and S1's is
-# about 0.045 h² (0.0124 s at h = 10/9 m, benchmarks/stable_dt.sh).
+# step is 0.02 h²: on fine grids bending sets the largest stable Verlet step, which shrinks
+# with h² (docs/stability.md); S1's is about 0.045 h² (0.0124 s at h = 10/9 m,
+# `cosserat stable-dt`).
 #   jobs/make_large_sheet.sh NODES STEPS FILE
 set -euo pipefail
 nodes=$1

@@ -86,8 +86,12 @@ TEST_F(Cli, HelpDocumentsEveryOption) {
   const Result run = cosserat("run --help");
   EXPECT_EQ(run.status, 0);
   for (const char* option : {"--set", "--output", "--summary", "--quiet", "--checkpoint-every",
-                             "--restart"})
+                             "--restart", "--until-rest", "--petsc"})
     EXPECT_THAT(run.output, HasSubstr(option));
+  const Result stable = cosserat("stable-dt --help");
+  EXPECT_EQ(stable.status, 0);
+  for (const char* option : {"--integrator", "--time", "--tolerance", "--set", "--csv"})
+    EXPECT_THAT(stable.output, HasSubstr(option));
 }
 
 TEST_F(Cli, MissingSceneFileIsBadInput) {
@@ -284,5 +288,118 @@ TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {
   EXPECT_THAT(output, HasSubstr("cannot be split over 4 MPI ranks"));
   EXPECT_FALSE(fs::exists(path("x.h5")));
 }
+
+
+std::string fmt_run(const std::string& scene, double dt, long steps, const std::string& output) {
+  std::ostringstream command;
+  command.precision(17);
+  command << "run " << scene << " -q --set time.dt=" << dt << " --set time.steps=" << steps
+          << " --set time.output_every=" << steps << " -o " << output;
+  return command.str();
+}
+
+std::string read_text(const std::string& file) {
+  std::stringstream text;
+  text << std::ifstream(file).rdbuf();
+  return text.str();
+}
+
+// The number after "key": in a JSON text (NaN when absent or null).
+double json_value(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::strtod(json.c_str() + at + key.size() + 4, nullptr);
+}
+
+// Field `column` of the first data row of a CSV file whose header names it.
+std::string csv_field(const std::string& file, const std::string& column) {
+  std::ifstream in(file);
+  std::string header, row;
+  std::getline(in, header);
+  std::getline(in, row);
+  auto split = [](const std::string& line) {
+    std::vector<std::string> fields;
+    std::stringstream s(line);
+    for (std::string f; std::getline(s, f, ',');) fields.push_back(f);
+    return fields;
+  };
+  const auto names = split(header), values = split(row);
+  const auto it = std::find(names.begin(), names.end(), column);
+  if (it == names.end() || values.size() < names.size()) return {};
+  return values[static_cast<std::size_t>(it - names.begin())];
+}
+
+// stable-dt brackets the limit to its tolerance, and `run` agrees with it on both sides: the
+// stable step runs to the end, the unstable one is stopped by the monitor (exit 3).
+TEST_F(Cli, StableDtBracketsTheLimitThatRunSees) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = cosserat("stable-dt " + scene + " --time 0.5 -q --csv " + path("dt.csv"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("CFL estimate"));
+  const double stable = std::stod(csv_field(path("dt.csv"), "stable_dt"));
+  const double unstable = std::stod(csv_field(path("dt.csv"), "unstable_dt"));
+  ASSERT_GT(stable, 0.0);
+  EXPECT_GT(unstable, stable);
+  EXPECT_LE(unstable, 1.02 * stable);
+  for (const auto& [dt, status] : {std::pair{stable, 0}, std::pair{unstable, 3}}) {
+    const long steps = std::lround(std::ceil(0.5 / dt - 1e-9));
+    const Result run = cosserat(fmt_run(scene, dt, steps, path("b.h5")));
+    EXPECT_EQ(run.status, status) << "dt = " << dt << "\n" << run.output;
+  }
+}
+
+TEST_F(Cli, StableDtBadInputIsExitTwo) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  EXPECT_EQ(cosserat("stable-dt " + path("absent.toml")).status, 2);
+  const Result unknown = cosserat("stable-dt " + scene + " --integrator sideways");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_THAT(unknown.output, HasSubstr("sideways"));
+  EXPECT_EQ(cosserat("stable-dt " + scene + " --time -1").status, 2);
+  EXPECT_EQ(cosserat("stable-dt " + scene + " --tolerance 2").status, 2);
+}
+
+// --until-rest stops at the first step below the fraction of the peak kinetic energy and says
+// which step that was; the run is "ok" and its last frame is that step.
+TEST_F(Cli, UntilRestStopsAtRest) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = cosserat("run " + scene + " --set time.steps=40000 --until-rest 1e-3 -o " +
+                            path("r.h5") + " --summary " + path("r.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string json = read_text(path("r.json"));
+  const double rest_step = json_value(json, "step");
+  EXPECT_GT(rest_step, 100.0);
+  EXPECT_LT(rest_step, 40000.0);
+  EXPECT_EQ(json_value(json, "steps"), rest_step);
+  EXPECT_LT(json_value(json, "kinetic_energy"), 1e-3 * json_value(json, "peak_kinetic_energy"));
+  EXPECT_THAT(json, HasSubstr("\"status\": \"ok\""));
+}
+
+#if defined(COSSERAT_HAVE_PETSC)
+// The semi-implicit run reports one linear solve per step and its iterations.
+TEST_F(Cli, SemiImplicitReportsItsSolves) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = cosserat("run " + scene + " --set time.integrator=semi-implicit --set time.steps=30 -o " +
+                            path("si.h5") + " --summary " + path("si.json"));
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("Krylov iterations per step"));
+  const std::string json = read_text(path("si.json"));
+  EXPECT_EQ(json_value(json, "solves"), 30.0);
+  EXPECT_GE(json_value(json, "mean_iterations"), 1.0);
+}
+
+// Solver names PETSc does not know, from the scene or from --petsc: bad input before any work.
+TEST_F(Cli, UnknownSolverIsBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result ksp = cosserat("run " + scene + " --set time.integrator=semi-implicit " +
+                              "--set time.solver.ksp=sideways -o " + path("k.h5"));
+  EXPECT_EQ(ksp.status, 2) << ksp.output;
+  EXPECT_THAT(ksp.output, HasSubstr("time.solver.ksp"));
+  EXPECT_FALSE(fs::exists(path("k.h5")));
+  const Result option = cosserat("run " + scene + " --set time.integrator=semi-implicit " +
+                                 "--petsc \"-pc_type sideways\" -o " + path("p.h5"));
+  EXPECT_EQ(option.status, 2) << option.output;
+  EXPECT_FALSE(fs::exists(path("p.h5")));
+}
+#endif
 
 }  // namespace

@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The integrator study of issue 4 (docs/integrator-study.md): largest stable Δt of S1-S6 and the
+# hard cases per scheme beside the CFL estimate, speed against error on S1, S2 and a 120 x 120
+# hanging sheet, and time to rest on S1, S2, S3, S5. Writes
+# benchmarks/results/accuracy-<host>-<date>{-stability,-accuracy,-rest}.csv, the plots
+# (-work-precision.png, -error-vs-dt.png), the summary (.md) and the log of every run (.log).
+# About an hour and a half on two cores; --quick checks the pipeline in a few minutes.
+#   benchmarks/run_accuracy.sh [--quick] [--parts stability,accuracy,rest]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source benchmarks/context.sh accuracy release cosserat
+case " $* " in *" --quick "*) stem=$stem-quick ;; esac
+
+/usr/bin/python3 tools/accuracy_study.py --exe build/release/cosserat --out "$stem" "$@"
+/usr/bin/python3 tools/accuracy_report.py "$stem" --machine "$cpu, $(nproc) cores, $host" \
+  --build "$compiler, release (-O3), git $revision" --date "$date"

@@ -1,0 +1,319 @@
+#!/usr/bin/python3
+"""The integrator study of issue 4, run through the `cosserat` executable.
+
+  stability   largest stable dt (`cosserat stable-dt`) of S1-S6 and the hard cases, per scheme
+  accuracy    error at time T against a reference run, and wall time, for a dt sweep per scheme
+  rest        steps and wall time until the kinetic energy is below 1e-6 of its peak
+
+Writes CSV files, PNG plots and a markdown summary under OUT (a path stem). Runs WORKERS
+single-threaded processes side by side. See docs/integrator-study.md for the definitions.
+
+  /usr/bin/python3 tools/accuracy_study.py --exe build/release/cosserat --out STEM
+"""
+
+import argparse
+import concurrent.futures
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+SCHEMES = ["verlet", "symplectic-euler", "euler", "midpoint", "rk4", "leapfrog",
+           "velocity-verlet", "tc-verlet", "verlet-lagged", "semi-implicit"]
+ROOT = Path(__file__).resolve().parent.parent
+SCENES = ROOT / "scenes"
+
+
+def scene_path(name):
+    return str(SCENES / name)
+
+
+class Study:
+    def __init__(self, args):
+        self.exe = args.exe
+        self.out = Path(args.out)
+        self.workers = args.workers
+        self.work = Path(tempfile.mkdtemp(prefix="cosserat-study-"))
+        self.env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
+                        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+        self.quick = args.quick
+        self.log = open(str(self.out) + ".log", "w")
+
+    def say(self, text):
+        print(text, flush=True)
+        self.log.write(text + "\n")
+        self.log.flush()
+
+    def scene_file(self, label, text):
+        path = self.work / f"{file_name(label)}.toml"
+        path.write_text(text)
+        return str(path)
+
+    # ------------------------------------------------------------------------------------------
+    # Stability
+
+    def stable_dt(self, case):
+        """One `cosserat stable-dt` call: case = (label, scene, overrides, T, schemes)."""
+        label, scene, overrides, duration, schemes = case
+        csv_path = self.work / f"stable-{file_name(label)}.csv"
+        command = [self.exe, "stable-dt", scene, "--time", str(duration), "-q",
+                   "--csv", str(csv_path)]
+        for s in schemes:
+            command += ["--integrator", s]
+        for o in overrides:
+            command += ["--set", o]
+        done = subprocess.run(command, env=self.env, capture_output=True, text=True)
+        rows = []
+        if csv_path.exists():
+            with open(csv_path) as f:
+                for row in csv.DictReader(f):
+                    row["case"] = label
+                    row["exit_status"] = done.returncode
+                    rows.append(row)
+        return label, done.returncode, done.stdout + done.stderr, rows
+
+    def stability(self, cases):
+        rows = []
+        with concurrent.futures.ThreadPoolExecutor(self.workers) as pool:
+            for label, status, text, case_rows in pool.map(self.stable_dt, cases):
+                self.say(f"stable-dt {label}: exit {status}\n{text.strip()}")
+                if status != 0:
+                    self.say(f"  !! stable-dt {label} did not finish cleanly (exit {status})")
+                rows += case_rows
+        return rows
+
+    # ------------------------------------------------------------------------------------------
+    # Runs
+
+    def run(self, label, scene, overrides, until_rest=None, timeout=None):
+        """One `cosserat run` without frames but the first and last: (summary, final positions)."""
+        stem = self.work / file_name(label)
+        command = [self.exe, "run", scene, "-q", "-o", f"{stem}.h5", "--summary",
+                   f"{stem}.json"]
+        for o in overrides:
+            command += ["--set", o]
+        if until_rest:
+            command += ["--until-rest", str(until_rest)]
+        try:
+            done = subprocess.run(command, env=self.env, capture_output=True, text=True,
+                                  timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return {"status": "timed out", "exit_status": None}, None
+        summary = {"status": "no summary"}
+        if Path(f"{stem}.json").exists():
+            summary = json.loads(Path(f"{stem}.json").read_text())
+        summary["exit_status"] = done.returncode
+        if done.returncode not in (0, 3):
+            summary["status"] = f"exit {done.returncode}: {done.stderr.strip()[-200:]}"
+        positions = None
+        if Path(f"{stem}.h5").exists() and done.returncode == 0:
+            with h5py.File(f"{stem}.h5", "r") as f:
+                positions = f["positions"][-1].reshape(-1, 3)
+        for suffix in (".h5", ".xmf", ".json"):
+            Path(f"{stem}{suffix}").unlink(missing_ok=True)
+        return summary, positions
+
+    # ------------------------------------------------------------------------------------------
+    # Accuracy
+
+    def accuracy(self, label, scene, duration, limits, levels, size):
+        """Sweep each scheme from its stable limit down by halves; error against RK4."""
+        jobs = []
+        for scheme in SCHEMES:
+            limit = limits.get(scheme, 0.0)
+            if not limit > 0.0:
+                continue
+            for j in range(levels):
+                steps = math.ceil(duration / (limit / 2 ** j) - 1e-9)
+                jobs.append((scheme, steps))
+        smallest = duration / max(steps for _, steps in jobs)
+        # The reference: RK4 at 1/8 of the smallest swept step, but no finer than 1/256 of its
+        # own limit, where its error is at round-off (the Richardson estimate below says so):
+        # euler's tiny limits would otherwise ask for hours (docs/integrator-study.md).
+        reference_steps = min(8 * max(steps for _, steps in jobs),
+                              math.ceil(256 * duration / limits["rk4"]))
+        self.say(f"{label}: reference rk4 with {reference_steps} steps "
+                 f"(dt = {duration / reference_steps:.3g} s; smallest swept {smallest:.3g} s)")
+
+        def one(job):
+            scheme, steps = job
+            summary, positions = self.run(
+                f"{label}-{scheme}-{steps}", scene,
+                [f'time.integrator="{scheme}"', f"time.dt={duration / steps!r}",
+                 f"time.steps={steps}", f"time.output_every={steps}"])
+            return scheme, steps, summary, positions
+
+        with concurrent.futures.ThreadPoolExecutor(self.workers) as pool:
+            reference_jobs = list(pool.map(one, [("rk4", reference_steps),
+                                                 ("rk4", reference_steps // 2)]))
+            results = list(pool.map(one, jobs))
+        reference = reference_jobs[0][3]
+        reference_error = rms(reference_jobs[1][3] - reference, size) / 15.0
+        self.say(f"{label}: reference's own error (Richardson, order 4): {reference_error:.2e}")
+        rows = []
+        for scheme, steps, summary, positions in results:
+            error = rms(positions - reference, size) if positions is not None else float("nan")
+            rows.append({"scene": label, "integrator": scheme, "dt": duration / steps,
+                         "steps": steps, "wall_seconds": summary.get("wall_seconds"),
+                         "error": error, "status": summary.get("status"),
+                         "reference_error": reference_error})
+            self.say(f"  {label} {scheme:17s} dt {duration / steps:.4g} error {error:.3e} "
+                     f"wall {summary.get('wall_seconds')} {summary.get('status')}")
+        return rows
+
+    # ------------------------------------------------------------------------------------------
+    # Time to rest
+
+    def rest(self, label, scene, limits, longest, timeout):
+        text = Path(scene).read_text()
+        base_dt = float(re.search(r"^dt\s*=\s*([0-9.eE+-]+)", text, re.M).group(1))
+
+        def attempt(scheme, dt):
+            # Windows of fixes and loads are given in steps: keep them at the same times.
+            scaled = re.sub(r"^(start|end)(\s*=\s*)(\d+)",
+                            lambda m: f"{m.group(1)}{m.group(2)}"
+                                      f"{round(int(m.group(3)) * base_dt / dt)}",
+                            text, flags=re.M)
+            path = self.scene_file(f"rest-{label}-{scheme}", scaled)
+            steps = math.ceil(longest / dt)
+            return self.run(f"rest-{label}-{scheme}", path,
+                            [f'time.integrator="{scheme}"', f"time.dt={dt!r}",
+                             f"time.steps={steps}", f"time.output_every={steps}"],
+                            until_rest=1e-6, timeout=timeout)
+
+        def one(scheme):
+            # 90 % of the limit over the stability study's T; a run that goes unstable later, on
+            # its way to rest, is repeated at half the step, twice at most.
+            dt = 0.9 * limits[scheme]
+            summary, _ = attempt(scheme, dt)
+            for _ in range(2):
+                if summary.get("status") != "unstable":
+                    break
+                dt *= 0.5
+                summary, _ = attempt(scheme, dt)
+            rest = summary.get("rest") or {}
+            row = {"scene": label, "integrator": scheme, "dt": dt,
+                   "dt_over_limit": dt / limits[scheme],
+                   "rest_step": rest.get("step"),
+                   "rest_time": rest["step"] * dt if rest.get("step") else None,
+                   "wall_seconds": summary.get("wall_seconds"),
+                   "status": summary.get("status")}
+            self.say(f"  rest {label} {scheme:17s} dt {dt:.4g}: step {row['rest_step']} "
+                     f"wall {row['wall_seconds']} {row['status']}")
+            return row
+
+        schemes = [s for s in SCHEMES if limits.get(s, 0.0) > 0.0]
+        with concurrent.futures.ThreadPoolExecutor(self.workers) as pool:
+            return list(pool.map(one, schemes))
+
+
+def file_name(label):
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", label)
+
+
+def rms(difference, size):
+    return float(np.sqrt(np.mean(np.sum(difference ** 2, axis=1)))) / size
+
+
+def write_csv(path, rows):
+    if not rows:
+        return
+    keys = list(rows[0].keys())
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        writer.writeheader()
+        writer.writerows(rows)
+
+
+def limits_of(rows, case):
+    return {r["integrator"]: float(r["stable_dt"]) for r in rows if r["case"] == case}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--exe", required=True, help="the cosserat executable")
+    parser.add_argument("--out", required=True, help="stem of the result files")
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--quick", action="store_true",
+                        help="small sizes and times: a check that the study runs, not results")
+    parser.add_argument("--parts", default="stability,accuracy,rest")
+    args = parser.parse_args()
+    study = Study(args)
+    parts = args.parts.split(",")
+    quick = args.quick
+
+    # The hanging sheet of the accuracy study and S1 at 240 x 240: S1's supports at the two
+    # corners of one edge, at any resolution (jobs/make_large_sheet.sh).
+    def hanging(nodes):
+        path = study.work / f"hanging-{nodes}.toml"
+        subprocess.run(["bash", str(ROOT / "jobs/make_large_sheet.sh"), str(nodes), "100",
+                        str(path)], check=True)
+        return str(path)
+
+    s6_text = Path(scene_path("s6_compression.toml")).read_text()
+    s6_loads_x5 = study.scene_file("s6-loads-x5", re.sub(
+        r"^(force\s*=\s*)\[([^\]]*)\]",
+        lambda m: m.group(1) + "[" + ", ".join(repr(5 * float(v)) for v in m.group(2).split(","))
+        + "]", s6_text, flags=re.M))
+
+    T = 0.2 if quick else 2.0  # simulated time each stability trial must survive
+    T_fine = 0.05 if quick else 0.2
+    hanging_nodes = 24 if quick else 120
+    big_nodes = 30 if quick else 240
+    scenes = {"S1": "s1_clothesline.toml", "S2": "s2_cape.toml", "S3": "s3_bench.toml",
+              "S4": "s4_flag.toml", "S5": "s5_armchair.toml", "S6": "s6_compression.toml"}
+    hanging_scene = hanging(hanging_nodes)
+    cases = [(k, scene_path(v), [], T, SCHEMES) for k, v in scenes.items()]
+    cases += [
+        ("S1 zeta=500", scene_path(scenes["S1"]), ["material.zeta=500.0"], T, SCHEMES),
+        ("S1 mass/10", scene_path(scenes["S1"]), ["material.mass=1.0"], T, SCHEMES),
+        ("S1 mass*13", scene_path(scenes["S1"]), ["material.mass=130.0"], T, SCHEMES),
+        ("S1 phi=1", scene_path(scenes["S1"]), ["material.phi=1.0"], T, SCHEMES),
+        ("S1 xi=0", scene_path(scenes["S1"]), ["material.xi=0.0"], T, SCHEMES),
+        ("S6 phi=1", scene_path(scenes["S6"]), ["material.phi=1.0"], T, SCHEMES),
+        ("S6 xi=0", scene_path(scenes["S6"]), ["material.xi=0.0"], T, SCHEMES),
+        ("S6 loads*5", s6_loads_x5, [], T, SCHEMES),
+        (f"hanging {hanging_nodes}", hanging_scene, [], T_fine, SCHEMES),
+        # Without euler (its limit there is ~1e-6 s: hours of trials) and the semi-implicit
+        # step (76 force evaluations a step): docs/integrator-study.md.
+        (f"S1 {big_nodes}x{big_nodes}", hanging(big_nodes), [], T_fine / 2,
+         [s for s in SCHEMES if s not in ("euler", "semi-implicit")]),
+    ]
+    stem = str(study.out)
+    if "stability" in parts:
+        stability_rows = study.stability(cases)
+        write_csv(stem + "-stability.csv", stability_rows)
+    else:
+        with open(stem + "-stability.csv") as f:
+            stability_rows = list(csv.DictReader(f))
+
+    if "accuracy" in parts:
+        accuracy_rows = []
+        for label, scene, duration in [("S1", scene_path(scenes["S1"]), T),
+                                       ("S2", scene_path(scenes["S2"]), T),
+                                       (f"hanging {hanging_nodes}", hanging_scene, T_fine)]:
+            levels = 4 if label.startswith("hanging") else 6
+            accuracy_rows += study.accuracy(label, scene, duration,
+                                            limits_of(stability_rows, label), levels, 10.0)
+            write_csv(stem + "-accuracy.csv", accuracy_rows)
+
+    if "rest" in parts:
+        rest_rows = []
+        for label in ["S1", "S2", "S3", "S5"]:
+            rest_rows += study.rest(label, scene_path(scenes[label]),
+                                    limits_of(stability_rows, label),
+                                    longest=10.0 if quick else 60.0,
+                                    timeout=60 if quick else 300)
+            write_csv(stem + "-rest.csv", rest_rows)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
