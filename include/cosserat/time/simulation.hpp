@@ -34,8 +34,9 @@ class Simulation {
   Simulation& operator=(const Simulation&) = delete;
 
   // Upper bound of the memory one rank's block takes: every field of the most demanding
-  // scheme, the force kernel's intermediates and the output buffer.
-  static double memory_bytes(const Block& block);
+  // explicit scheme, the force kernel's intermediates and the output buffer, and for the
+  // semi-implicit one its PETSc matrix and colouring.
+  static double memory_bytes(const Block& block, Integrator integrator);
 
   std::optional<Instability> step() { return stepper_.step(); }
   long step_index() const { return stepper_.step_index(); }
