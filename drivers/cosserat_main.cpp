@@ -309,8 +309,8 @@ int stable_dt(const StableDtOptions& options, int rank) {
       std::vector<std::string> overrides = options.overrides;
       overrides.push_back(fmt::format("time.integrator=\"{}\"", name));
       scenes.push_back(load_scene(options.scene_path, overrides));
-      Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
     }
+    Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
   } catch (const SceneError& e) {
     if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
     return kExitBadInput;
