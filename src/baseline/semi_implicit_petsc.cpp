@@ -17,12 +17,10 @@ namespace cosserat {
 
 namespace {
 
-void check(PetscErrorCode code,
-           std::source_location where = std::source_location::current()) {
+void check(PetscErrorCode code, std::source_location where = std::source_location::current()) {
   if (code != 0) {
-    throw std::runtime_error(
-        fmt::format("PETSc error {} in {} ({}:{})", static_cast<int>(code),
-                    where.function_name(), where.file_name(), where.line()));
+    throw std::runtime_error(fmt::format("PETSc error {} in {} ({}:{})", static_cast<int>(code),
+                                         where.function_name(), where.file_name(), where.line()));
   }
 }
 
@@ -31,8 +29,7 @@ bool petsc_started_here = false;
 void start_petsc() {
   PetscBool initialized = PETSC_FALSE;
   check(PetscInitialized(&initialized));
-  if (initialized)
-    return;
+  if (initialized) return;
   // Signals stay the driver's: a job's SIGTERM or a crash ends the run as it
   // does without PETSc.
   check(PetscOptionsSetValue(nullptr, "-no_signal_handler", nullptr));
@@ -42,44 +39,39 @@ void start_petsc() {
 
 // Runs a PETSc call whose failure means bad input (a name PETSc does not know),
 // quietly, and reports it as a scene error naming `key`.
-template <class Call> void set_or_refuse(Call &&call, const std::string &what) {
+template <class Call>
+void set_or_refuse(Call&& call, const std::string& what) {
   check(PetscPushErrorHandler(PetscReturnErrorHandler, nullptr));
   const PetscErrorCode code = call();
   check(PetscPopErrorHandler());
-  if (code != 0)
-    throw SceneError(what);
+  if (code != 0) throw SceneError(what);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-      .count();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-} // namespace
+}  // namespace
 
 struct SemiImplicitSolver::Impl {
-  Impl(const Scene &scene, const Decomposition &decomposition,
-       const Block &block, Dynamics &dynamics);
+  Impl(const Scene& scene, const Decomposition& decomposition, const Block& block,
+       Dynamics& dynamics);
   ~Impl();
 
   // The function MatFDColoring differences: the internal acceleration at the
   // global vector x.
-  static PetscErrorCode internal_acceleration(void *unused, Vec x, Vec f,
-                                              void *self);
+  static PetscErrorCode internal_acceleration(void* unused, Vec x, Vec f, void* self);
 
   // Offset of component c of owned node (k, l) in this rank's part of a global
   // vector.
   PetscInt offset(int k, int l, int c) const {
-    return (static_cast<PetscInt>(l - block->l0) * block->owned_k() +
-            (k - block->k0)) *
-               3 +
-           c;
+    return (static_cast<PetscInt>(l - block->l0) * block->owned_k() + (k - block->k0)) * 3 + c;
   }
-  void copy_in(const Field<Vec3> &field, Vec v) const;
-  void copy_out(Vec v, Field<Vec3> &field) const;
+  void copy_in(const Field<Vec3>& field, Vec v) const;
+  void copy_out(Vec v, Field<Vec3>& field) const;
 
-  const Block *block;
-  Dynamics *dynamics;
+  const Block* block;
+  Dynamics* dynamics;
   double dt;
   DM da = nullptr;
   Mat matrix = nullptr;
@@ -91,31 +83,25 @@ struct SemiImplicitSolver::Impl {
   LinearSolveStats stats;
 };
 
-SemiImplicitSolver::Impl::Impl(const Scene &scene,
-                               const Decomposition &decomposition,
-                               const Block &block_, Dynamics &dynamics_)
-    : block(&block_), dynamics(&dynamics_), dt(scene.dt), r_view(block_),
-      a_view(block_) {
+SemiImplicitSolver::Impl::Impl(const Scene& scene, const Decomposition& decomposition,
+                               const Block& block_, Dynamics& dynamics_)
+    : block(&block_), dynamics(&dynamics_), dt(scene.dt), r_view(block_), a_view(block_) {
   start_petsc();
-  const Block &bl = *block;
+  const Block& bl = *block;
   std::vector<PetscInt> widths_k, widths_l;
-  for (const int w : decomposition.widths_k())
-    widths_k.push_back(w);
-  for (const int w : decomposition.widths_l())
-    widths_l.push_back(w);
+  for (const int w : decomposition.widths_k()) widths_k.push_back(w);
+  for (const int w : decomposition.widths_l()) widths_l.push_back(w);
   // Same ranks, same blocks: a DMDA numbers its processes k-fastest, as
   // Decomposition does. Its ghost ring is the force kernel's (kGhostWidth, box:
   // diagonals included).
-  check(DMDACreate2d(bl.comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE,
-                     DMDA_STENCIL_BOX, bl.m, bl.n, decomposition.parts_k(),
-                     decomposition.parts_l(), 3, kGhostWidth, widths_k.data(),
-                     widths_l.data(), &da));
+  check(DMDACreate2d(bl.comm, DM_BOUNDARY_NONE, DM_BOUNDARY_NONE, DMDA_STENCIL_BOX, bl.m, bl.n,
+                     decomposition.parts_k(), decomposition.parts_l(), 3, kGhostWidth,
+                     widths_k.data(), widths_l.data(), &da));
   check(DMSetUp(da));
   PetscInt xs, ys, xm, ym;
   check(DMDAGetCorners(da, &xs, &ys, nullptr, &xm, &ym, nullptr));
   if (xs != bl.k0 || ys != bl.l0 || xs + xm != bl.k1 || ys + ym != bl.l1) {
-    throw std::logic_error(
-        "the DMDA's blocks differ from the solver's decomposition");
+    throw std::logic_error("the DMDA's blocks differ from the solver's decomposition");
   }
 
   check(DMSetMatType(da, MATAIJ));
@@ -131,45 +117,39 @@ SemiImplicitSolver::Impl::Impl(const Scene &scene,
   check(MatFDColoringCreate(matrix, colours, &colouring));
   // PETSc takes the function type-erased; void(*)(void) is the cast GCC accepts
   // as generic.
-  check(MatFDColoringSetFunction(
-      colouring,
-      reinterpret_cast<PetscErrorCode (*)(void)>(
-          reinterpret_cast<void (*)(void)>(&Impl::internal_acceleration)),
-      this));
+  check(
+      MatFDColoringSetFunction(colouring,
+                               reinterpret_cast<PetscErrorCode (*)(void)>(
+                                   reinterpret_cast<void (*)(void)>(&Impl::internal_acceleration)),
+                               this));
   // A position's perturbation is sqrt(eps) times its size, but at least
   // sqrt(eps) times a grid spacing: PETSc's floor (1e-6) would perturb a node
   // near the origin by 1e-14 m and lose the difference in round-off.
-  check(MatFDColoringSetParameters(colouring, PETSC_DEFAULT,
-                                   std::min(scene.h1(), scene.h2())));
+  check(MatFDColoringSetParameters(colouring, PETSC_DEFAULT, std::min(scene.h1(), scene.h2())));
   check(MatFDColoringSetFromOptions(colouring));
   check(MatFDColoringSetUp(matrix, colours, colouring));
   check(ISColoringDestroy(&colours));
 
   check(KSPCreate(bl.comm, &ksp));
   check(KSPSetOperators(ksp, matrix, matrix));
-  const LinearSolver &linear = scene.solver;
-  set_or_refuse(
-      [&] { return KSPSetType(ksp, linear.ksp.c_str()); },
-      fmt::format(
-          "{}: time.solver.ksp: PETSc has no Krylov method \"{}\" (for example "
-          "gmres, fgmres, bcgs, cg, richardson)",
-          scene.path, linear.ksp));
+  const LinearSolver& linear = scene.solver;
+  set_or_refuse([&] { return KSPSetType(ksp, linear.ksp.c_str()); },
+                fmt::format("{}: time.solver.ksp: PETSc has no Krylov method \"{}\" (for example "
+                            "gmres, fgmres, bcgs, cg, richardson)",
+                            scene.path, linear.ksp));
   PC pc;
   check(KSPGetPC(ksp, &pc));
-  set_or_refuse(
-      [&] { return PCSetType(pc, linear.pc.c_str()); },
-      fmt::format(
-          "{}: time.solver.pc: PETSc has no preconditioner \"{}\" (for example "
-          "bjacobi, jacobi, sor, gamg, none)",
-          scene.path, linear.pc));
+  set_or_refuse([&] { return PCSetType(pc, linear.pc.c_str()); },
+                fmt::format("{}: time.solver.pc: PETSc has no preconditioner \"{}\" (for example "
+                            "bjacobi, jacobi, sor, gamg, none)",
+                            scene.path, linear.pc));
   check(KSPSetTolerances(ksp, linear.rtol, linear.atol, PETSC_DEFAULT,
                          static_cast<PetscInt>(linear.max_iterations)));
   // The last step's δ starts the iteration (the stepper passes d = rⁿ − rⁿ⁻¹).
   check(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
-  set_or_refuse(
-      [&] { return KSPSetFromOptions(ksp); },
-      "the PETSc options (--petsc or PETSC_OPTIONS) name a Krylov method or "
-      "preconditioner PETSc does not have; see the message above");
+  set_or_refuse([&] { return KSPSetFromOptions(ksp); },
+                "the PETSc options (--petsc or PETSC_OPTIONS) name a Krylov method or "
+                "preconditioner PETSc does not have; see the message above");
 }
 
 SemiImplicitSolver::Impl::~Impl() {
@@ -184,41 +164,36 @@ SemiImplicitSolver::Impl::~Impl() {
   DMDestroy(&da);
 }
 
-void SemiImplicitSolver::Impl::copy_in(const Field<Vec3> &field, Vec v) const {
-  PetscScalar *data;
+void SemiImplicitSolver::Impl::copy_in(const Field<Vec3>& field, Vec v) const {
+  PetscScalar* data;
   check(VecGetArray(v, &data));
-  const Block &bl = *block;
+  const Block& bl = *block;
 #pragma omp parallel for schedule(static)
   for (int l = bl.l0; l < bl.l1; ++l)
     for (int k = bl.k0; k < bl.k1; ++k)
-      for (int c = 0; c < 3; ++c)
-        data[offset(k, l, c)] = field(k, l)[c];
+      for (int c = 0; c < 3; ++c) data[offset(k, l, c)] = field(k, l)[c];
   check(VecRestoreArray(v, &data));
 }
 
-void SemiImplicitSolver::Impl::copy_out(Vec v, Field<Vec3> &field) const {
-  const PetscScalar *data;
+void SemiImplicitSolver::Impl::copy_out(Vec v, Field<Vec3>& field) const {
+  const PetscScalar* data;
   check(VecGetArrayRead(v, &data));
-  const Block &bl = *block;
+  const Block& bl = *block;
 #pragma omp parallel for schedule(static)
   for (int l = bl.l0; l < bl.l1; ++l)
     for (int k = bl.k0; k < bl.k1; ++k)
-      field(k, l) = Vec3{data[offset(k, l, 0)], data[offset(k, l, 1)],
-                         data[offset(k, l, 2)]};
+      field(k, l) = Vec3{data[offset(k, l, 0)], data[offset(k, l, 1)], data[offset(k, l, 2)]};
   check(VecRestoreArrayRead(v, &data));
 }
 
-PetscErrorCode SemiImplicitSolver::Impl::internal_acceleration(void *, Vec x,
-                                                               Vec f,
-                                                               void *self) {
+PetscErrorCode SemiImplicitSolver::Impl::internal_acceleration(void*, Vec x, Vec f, void* self) {
   PetscFunctionBeginUser;
-  Impl &s = *static_cast<Impl *>(self);
+  Impl& s = *static_cast<Impl*>(self);
   PetscCall(DMGlobalToLocalBegin(s.da, x, INSERT_VALUES, s.local));
   PetscCall(DMGlobalToLocalEnd(s.da, x, INSERT_VALUES, s.local));
   PetscInt gxs, gys, gxm, gym;
-  PetscCall(
-      DMDAGetGhostCorners(s.da, &gxs, &gys, nullptr, &gxm, &gym, nullptr));
-  PetscScalar ***in;
+  PetscCall(DMDAGetGhostCorners(s.da, &gxs, &gys, nullptr, &gxm, &gym, nullptr));
+  PetscScalar*** in;
   PetscCall(DMDAVecGetArrayDOFRead(s.da, s.local, &in));
   for (PetscInt l = gys; l < gys + gym; ++l)
     for (PetscInt k = gxs; k < gxs + gxm; ++k)
@@ -226,26 +201,24 @@ PetscErrorCode SemiImplicitSolver::Impl::internal_acceleration(void *, Vec x,
           Vec3{in[l][k][0], in[l][k][1], in[l][k][2]};
   PetscCall(DMDAVecRestoreArrayDOFRead(s.da, s.local, &in));
   s.dynamics->internal_acceleration(s.r_view, s.a_view);
-  PetscScalar *out;
+  PetscScalar* out;
   PetscCall(VecGetArray(f, &out));
-  const Block &bl = *s.block;
+  const Block& bl = *s.block;
   for (int l = bl.l0; l < bl.l1; ++l)
     for (int k = bl.k0; k < bl.k1; ++k)
-      for (int c = 0; c < 3; ++c)
-        out[s.offset(k, l, c)] = s.a_view(k, l)[c];
+      for (int c = 0; c < 3; ++c) out[s.offset(k, l, c)] = s.a_view(k, l)[c];
   PetscCall(VecRestoreArray(f, &out));
   PetscFunctionReturn(0);
 }
 
-SemiImplicitSolver::SemiImplicitSolver(const Scene &scene,
-                                       const Decomposition &decomposition,
-                                       const Block &block, Dynamics &dynamics)
+SemiImplicitSolver::SemiImplicitSolver(const Scene& scene, const Decomposition& decomposition,
+                                       const Block& block, Dynamics& dynamics)
     : impl_(std::make_unique<Impl>(scene, decomposition, block, dynamics)) {}
 
 SemiImplicitSolver::~SemiImplicitSolver() = default;
 
-void SemiImplicitSolver::linearise(const Field<Vec3> &r) {
-  Impl &s = *impl_;
+void SemiImplicitSolver::linearise(const Field<Vec3>& r) {
+  Impl& s = *impl_;
   const auto start = std::chrono::steady_clock::now();
   s.copy_in(r, s.x);
   // The colouring writes only the entries it computes; start from a clean
@@ -255,13 +228,11 @@ void SemiImplicitSolver::linearise(const Field<Vec3> &r) {
   s.stats.jacobian_seconds += seconds_since(start);
 }
 
-std::optional<std::string>
-SemiImplicitSolver::solve(const VelocityTerms &terms, const Field<Vec3> &rhs,
-                          const Field<Vec3> &guess,
-                          const std::vector<Constraints::NodeState> &held,
-                          Field<Vec3> &delta) {
-  Impl &s = *impl_;
-  const Block &bl = *s.block;
+std::optional<std::string> SemiImplicitSolver::solve(
+    const VelocityTerms& terms, const Field<Vec3>& rhs, const Field<Vec3>& guess,
+    const std::vector<Constraints::NodeState>& held, Field<Vec3>& delta) {
+  Impl& s = *impl_;
+  const Block& bl = *s.block;
   const auto start = std::chrono::steady_clock::now();
   const double dt = s.dt;
   const double diagonal = 1.0 / (dt * dt) + terms.damping / (2.0 * dt);
@@ -279,11 +250,9 @@ SemiImplicitSolver::solve(const VelocityTerms &terms, const Field<Vec3> &rhs,
         PetscScalar block[9];
         for (int a = 0; a < 3; ++a) {
           node[a] = MatStencil{0, l, k, a};
-          for (int c = 0; c < 3; ++c)
-            block[3 * a + c] = weight * n[a] * n[c];
+          for (int c = 0; c < 3; ++c) block[3 * a + c] = weight * n[a] * n[c];
         }
-        check(
-            MatSetValuesStencil(s.matrix, 3, node, 3, node, block, ADD_VALUES));
+        check(MatSetValuesStencil(s.matrix, 3, node, 3, node, block, ADD_VALUES));
       }
     check(MatAssemblyBegin(s.matrix, MAT_FINAL_ASSEMBLY));
     check(MatAssemblyEnd(s.matrix, MAT_FINAL_ASSEMBLY));
@@ -292,13 +261,12 @@ SemiImplicitSolver::solve(const VelocityTerms &terms, const Field<Vec3> &rhs,
   // Held components: δ = 0, rows and columns replaced by the diagonal (symmetry
   // kept for cg).
   std::vector<PetscInt> held_rows;
-  for (const Constraints::NodeState &node : held)
+  for (const Constraints::NodeState& node : held)
     if (bl.owns(node.k, node.l))
       for (int c = 0; c < 3; ++c)
-        if (node.held & (1u << c))
-          held_rows.push_back(s.first_row + s.offset(node.k, node.l, c));
-  check(MatZeroRowsColumns(s.matrix, static_cast<PetscInt>(held_rows.size()),
-                           held_rows.data(), diagonal, nullptr, nullptr));
+        if (node.held & (1u << c)) held_rows.push_back(s.first_row + s.offset(node.k, node.l, c));
+  check(MatZeroRowsColumns(s.matrix, static_cast<PetscInt>(held_rows.size()), held_rows.data(),
+                           diagonal, nullptr, nullptr));
 
   s.copy_in(rhs, s.b);
   s.copy_in(guess, s.delta);
@@ -322,29 +290,24 @@ SemiImplicitSolver::solve(const VelocityTerms &terms, const Field<Vec3> &rhs,
   s.stats.most_iterations = std::max<long>(s.stats.most_iterations, iterations);
   s.stats.solve_seconds += seconds_since(start);
   if (reason < 0) {
-    return fmt::format(
-        "the linear solver did not converge ({} after {} iterations)",
-        KSPConvergedReasons[reason], iterations);
+    return fmt::format("the linear solver did not converge ({} after {} iterations)",
+                       KSPConvergedReasons[reason], iterations);
   }
   return std::nullopt;
 }
 
-const LinearSolveStats &SemiImplicitSolver::stats() const {
-  return impl_->stats;
-}
+const LinearSolveStats& SemiImplicitSolver::stats() const { return impl_->stats; }
 
-void add_petsc_options(const std::string &options) {
+void add_petsc_options(const std::string& options) {
   start_petsc();
   check(PetscOptionsInsertString(nullptr, options.c_str()));
 }
 
 void finalize_petsc() {
-  if (!petsc_started_here)
-    return;
+  if (!petsc_started_here) return;
   PetscBool finalized = PETSC_FALSE;
   check(PetscFinalized(&finalized));
-  if (!finalized)
-    check(PetscFinalize());
+  if (!finalized) check(PetscFinalize());
 }
 
-} // namespace cosserat
+}  // namespace cosserat

@@ -12,8 +12,8 @@ namespace cosserat {
 // has wave number π/h, where the compact second difference is 4/h² and the
 // fourth 16/h⁴; central differences are stable while ω Δt ≤ 2
 // (docs/stability.md).
-CflEstimate cfl_estimate(const Scene &scene) {
-  const Material &m = scene.material;
+CflEstimate cfl_estimate(const Scene& scene) {
+  const Material& m = scene.material;
   const double density = m.mass / (scene.size1 * scene.size2);
   const double h[2] = {scene.h1(), scene.h2()};
   CflEstimate e{};
@@ -27,17 +27,16 @@ CflEstimate cfl_estimate(const Scene &scene) {
     const int b = 1 - a;
     const double longitudinal = std::sqrt(6.0 * zeta_aa[a] / density);
     e.longitudinal_speed = std::max(e.longitudinal_speed, longitudinal);
-    const double rate2 = longitudinal * longitudinal / (h[a] * h[a]) +
-                         e.shear_speed * e.shear_speed / (h[b] * h[b]);
+    const double rate2 =
+        longitudinal * longitudinal / (h[a] * h[a]) + e.shear_speed * e.shear_speed / (h[b] * h[b]);
     e.membrane_dt = std::min(e.membrane_dt, 1.0 / std::sqrt(rate2));
     if (xi_aa[a] > 0.0) {
       e.bending_dt =
-          std::min(e.bending_dt,
-                   h[a] * h[a] / (2.0 * std::sqrt(6.0 * xi_aa[a] / density)));
+          std::min(e.bending_dt, h[a] * h[a] / (2.0 * std::sqrt(6.0 * xi_aa[a] / density)));
     }
   }
   e.dt = std::min(e.membrane_dt, e.bending_dt);
   return e;
 }
 
-} // namespace cosserat
+}  // namespace cosserat

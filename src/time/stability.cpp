@@ -9,8 +9,7 @@
 
 namespace cosserat {
 
-StabilityTrial run_trial(const Scene &scene, double dt, double duration,
-                         MPI_Comm comm) {
+StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm) {
   Scene trial_scene = scene;
   trial_scene.dt = dt;
   trial_scene.steps = static_cast<long>(std::ceil(duration / dt - 1e-9));
@@ -24,30 +23,24 @@ StabilityTrial run_trial(const Scene &scene, double dt, double duration,
       trial.stable = false;
       trial.cause =
           failure->solver_failure
-              ? fmt::format("step {}: {}", failure->step,
-                            *failure->solver_failure)
-              : fmt::format("step {}: node [{}, {}] {}", failure->step,
-                            failure->k, failure->l,
+              ? fmt::format("step {}: {}", failure->step, *failure->solver_failure)
+              : fmt::format("step {}: node [{}, {}] {}", failure->step, failure->k, failure->l,
                             failure->not_finite ? "not finite" : "moved > h/2");
       break;
     }
   }
   trial.steps = simulation.step_index();
   trial.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
-          .count();
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return trial;
 }
 
-StableStep
-largest_stable_step(const Scene &scene, double duration, double tolerance,
-                    MPI_Comm comm,
-                    const std::function<void(const StabilityTrial &)> &report) {
+StableStep largest_stable_step(const Scene& scene, double duration, double tolerance, MPI_Comm comm,
+                               const std::function<void(const StabilityTrial&)>& report) {
   StableStep result;
   auto trial = [&](double dt) {
     result.trials.push_back(run_trial(scene, dt, duration, comm));
-    if (report)
-      report(result.trials.back());
+    if (report) report(result.trials.back());
     return result.trials.back().stable;
   };
   const double floor = 1e-6 * scene.dt;
@@ -56,8 +49,7 @@ largest_stable_step(const Scene &scene, double duration, double tolerance,
     result.stable_dt = dt;
     while (result.unstable_dt == 0.0) {
       dt *= 2.0;
-      if (dt > duration)
-        return result;
+      if (dt > duration) return result;
       if (trial(dt))
         result.stable_dt = dt;
       else
@@ -67,8 +59,7 @@ largest_stable_step(const Scene &scene, double duration, double tolerance,
     result.unstable_dt = dt;
     while (result.stable_dt == 0.0) {
       dt *= 0.5;
-      if (dt < floor)
-        return result;
+      if (dt < floor) return result;
       if (trial(dt))
         result.stable_dt = dt;
       else
@@ -85,4 +76,4 @@ largest_stable_step(const Scene &scene, double duration, double tolerance,
   return result;
 }
 
-} // namespace cosserat
+}  // namespace cosserat

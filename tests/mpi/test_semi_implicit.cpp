@@ -28,15 +28,11 @@ TEST(SemiImplicitDecomposition, EverySplitFollowsTheOneBlockTrajectory) {
   const Simulation start(scene, MPI_COMM_SELF);
   ASSERT_TRUE(testing::advance(reference, scene.steps));
   // The comparison means something only if the sheet moved.
-  EXPECT_GT(
-      testing::largest_difference(reference.positions(), start.positions()),
-      1e-2);
-  for (const Decomposition &d :
-       testing::all_splits(scene.m, scene.n, testing::world_size())) {
+  EXPECT_GT(testing::largest_difference(reference.positions(), start.positions()), 1e-2);
+  for (const Decomposition& d : testing::all_splits(scene.m, scene.n, testing::world_size())) {
     Simulation sim(scene, MPI_COMM_WORLD, d);
     ASSERT_TRUE(testing::advance(sim, scene.steps));
-    const double difference =
-        testing::largest_difference(sim.positions(), reference.positions());
+    const double difference = testing::largest_difference(sim.positions(), reference.positions());
     if (testing::world_rank() == 0)
       std::printf("[semi-implicit] split %s: largest difference %.3g m\n",
                   testing::split_name(d).c_str(), difference);
@@ -49,5 +45,5 @@ TEST(SemiImplicitDecomposition, EverySplitFollowsTheOneBlockTrajectory) {
 
 #endif
 
-} // namespace
-} // namespace cosserat
+}  // namespace
+}  // namespace cosserat

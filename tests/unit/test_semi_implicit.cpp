@@ -56,7 +56,7 @@ TEST(SemiImplicit, WithoutStiffnessItIsVerlet) {
       worst = std::max(worst, norm(a.positions()(k, l) - b.positions()(k, l)));
       moved = std::max(moved, norm(a.positions()(k, l) - b.positions()(0, 0)));
     }
-  EXPECT_GT(moved, 1.0); // the comparison is not between two resting sheets
+  EXPECT_GT(moved, 1.0);  // the comparison is not between two resting sheets
   EXPECT_LT(worst, 1e-12 * verlet.size1);
 }
 
@@ -78,16 +78,14 @@ TEST(SemiImplicit, HeldComponentsStay) {
   EXPECT_EQ(sim.positions()(0, 0).z, pinned.z);
   EXPECT_EQ(sim.positions()(8, 6).y, y_held);
   EXPECT_GT(norm(sim.positions()(8, 6) - y_node),
-            1e-3); // its free components did move
+            1e-3);  // its free components did move
 }
 
-// The point of the baseline: S1 (SCENES.md) at three times Verlet's stability
-// limit (0.0124 s, measured by `cosserat stable-dt`; the CFL estimate is 0.0133
-// s) runs stably for 3 s, where Verlet is stopped by the monitor. The Jacobian
-// must be right for this, not just present.
+// The point of the baseline: S1 (SCENES.md) at three times the CFL estimate (0.0133 s; 3.2 times
+// Verlet's limit of 0.0124 s measured by `cosserat stable-dt`) runs stably for 3 s, where Verlet
+// is stopped by the monitor. The Jacobian must be right for this, not just present.
 TEST(SemiImplicit, StableBeyondTheExplicitLimit) {
-  Scene scene = load_scene(std::string(COSSERAT_SOURCE_DIR) +
-                           "/scenes/s1_clothesline.toml");
+  Scene scene = load_scene(std::string(COSSERAT_SOURCE_DIR) + "/scenes/s1_clothesline.toml");
   scene.dt = 3.0 * cfl_estimate(scene).dt;
   const long steps = std::lround(3.0 / scene.dt);
   scene.integrator = Integrator::verlet;
@@ -127,11 +125,9 @@ TEST(SemiImplicit, UnknownKrylovMethodIsASceneError) {
 
 #else
 
-TEST(SemiImplicit, NeedsPetsc) {
-  GTEST_SKIP() << "built without PETSc (COSSERAT_WITH_PETSC=OFF)";
-}
+TEST(SemiImplicit, NeedsPetsc) { GTEST_SKIP() << "built without PETSc (COSSERAT_WITH_PETSC=OFF)"; }
 
 #endif
 
-} // namespace
-} // namespace cosserat
+}  // namespace
+}  // namespace cosserat

@@ -29,39 +29,39 @@ namespace cosserat {
 // rank 0's; every rank takes part in every solve).
 struct LinearSolveStats {
   long solves = 0;
-  long iterations = 0;      // summed over the solves
-  long most_iterations = 0; // in one solve
+  long iterations = 0;       // summed over the solves
+  long most_iterations = 0;  // in one solve
   double jacobian_seconds = 0.0;
   double solve_seconds = 0.0;
 };
 
 class SemiImplicitSolver {
-public:
+ public:
   // Sets up the DMDA, Jacobian colouring and KSP from scene.solver, then
   // PETSc's options database (-ksp_*, -pc_*, ...). Starts PETSc on first use.
   // Throws SceneError for a KSP or PC name PETSc does not know.
-  SemiImplicitSolver(const Scene &scene, const Decomposition &decomposition,
-                     const Block &block, Dynamics &dynamics);
+  SemiImplicitSolver(const Scene& scene, const Decomposition& decomposition, const Block& block,
+                     Dynamics& dynamics);
   ~SemiImplicitSolver();
-  SemiImplicitSolver(const SemiImplicitSolver &) = delete;
-  SemiImplicitSolver &operator=(const SemiImplicitSolver &) = delete;
+  SemiImplicitSolver(const SemiImplicitSolver&) = delete;
+  SemiImplicitSolver& operator=(const SemiImplicitSolver&) = delete;
 
   // J at r (owned nodes; the DMDA fills its own ghosts). Evaluates the internal
   // force about 76 times, so Dynamics::normal() is stale afterwards.
-  void linearise(const Field<Vec3> &r);
+  void linearise(const Field<Vec3>& r);
 
   // Solves the system for δ with the J of the last linearise(), velocity terms
   // `terms` (normals from dynamics.normal()), right-hand side `rhs`, starting
   // from `guess`. The components `held` lists get δ = 0. Returns why the solve
   // failed, or nothing.
-  std::optional<std::string>
-  solve(const VelocityTerms &terms, const Field<Vec3> &rhs,
-        const Field<Vec3> &guess,
-        const std::vector<Constraints::NodeState> &held, Field<Vec3> &delta);
+  std::optional<std::string> solve(const VelocityTerms& terms, const Field<Vec3>& rhs,
+                                   const Field<Vec3>& guess,
+                                   const std::vector<Constraints::NodeState>& held,
+                                   Field<Vec3>& delta);
 
-  const LinearSolveStats &stats() const;
+  const LinearSolveStats& stats() const;
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
@@ -69,10 +69,10 @@ private:
 // Adds PETSc options (e.g. "-ksp_type cg -pc_type jacobi") for solvers made
 // later, starting PETSc if needed. PETSC_OPTIONS in the environment is read
 // too.
-void add_petsc_options(const std::string &options);
+void add_petsc_options(const std::string& options);
 
 // Ends PETSc if this process started it; before MPI_Finalize. Without PETSc,
 // nothing.
 void finalize_petsc();
 
-} // namespace cosserat
+}  // namespace cosserat

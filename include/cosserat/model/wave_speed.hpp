@@ -8,14 +8,14 @@
 namespace cosserat {
 
 struct CflEstimate {
-  double longitudinal_speed; // c_L = sqrt(6 ζ/μ), the largest over the two
-                             // directions (m/s)
-  double shear_speed;        // c_S = sqrt(ζ₁₂/μ)
-  double membrane_dt; // 1 / sqrt(c_L²/h² + c_S²/h'²), the tighter direction
-  double bending_dt;  // h² / (2 sqrt(6 ξ/μ)); infinite for ξ = 0
-  double dt;          // the smaller of the two
+  double longitudinal_speed;  // c_L = sqrt(6 ζ/μ), the largest over the two
+                              // directions (m/s)
+  double shear_speed;         // c_S = sqrt(ζ₁₂/μ)
+  double membrane_dt;         // 1 / sqrt(c_L²/h² + c_S²/h'²), the tighter direction
+  double bending_dt;          // h² / (2 sqrt(6 ξ/μ)); infinite for ξ = 0
+  double dt;                  // the smaller of the two
 };
 
-CflEstimate cfl_estimate(const Scene &scene);
+CflEstimate cfl_estimate(const Scene& scene);
 
-} // namespace cosserat
+}  // namespace cosserat

@@ -16,20 +16,17 @@ namespace cosserat {
 // One run of the scene at step dt over ceil(duration/dt) steps, without output.
 struct StabilityTrial {
   double dt = 0.0;
-  long steps = 0;      // steps run (the failing one not counted)
-  bool stable = false; // the monitor never stopped it
-  std::string cause;   // what stopped it, when it was stopped
+  long steps = 0;       // steps run (the failing one not counted)
+  bool stable = false;  // the monitor never stopped it
+  std::string cause;    // what stopped it, when it was stopped
   double wall_seconds = 0.0;
 };
 
-StabilityTrial run_trial(const Scene &scene, double dt, double duration,
-                         MPI_Comm comm);
+StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm);
 
 struct StableStep {
-  double stable_dt =
-      0.0; // the largest step found stable (0: none, down to the floor)
-  double unstable_dt =
-      0.0; // the smallest found unstable (0: none, up to the ceiling)
+  double stable_dt = 0.0;    // the largest step found stable (0: none, down to the floor)
+  double unstable_dt = 0.0;  // the smallest found unstable (0: none, up to the ceiling)
   std::vector<StabilityTrial> trials;
 };
 
@@ -38,8 +35,7 @@ struct StableStep {
 // each other (relative to the stable one). Steps above `duration` or below 1e-6
 // of the scene's dt end the search unbracketed. `report` sees every trial as it
 // ends (rank 0 prints progress with it).
-StableStep largest_stable_step(
-    const Scene &scene, double duration, double tolerance, MPI_Comm comm,
-    const std::function<void(const StabilityTrial &)> &report = {});
+StableStep largest_stable_step(const Scene& scene, double duration, double tolerance, MPI_Comm comm,
+                               const std::function<void(const StabilityTrial&)>& report = {});
 
-} // namespace cosserat
+}  // namespace cosserat
