@@ -122,20 +122,31 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
   return all_fit != 0;
 }
 
+// Runs `work` and turns the bad input it reports into a message from rank 0: exit status 2, or
+// nothing when all went well. Every rank finds the same bad input, so all return together.
+template <class Work>
+std::optional<int> bad_input(const std::string& scene_path, int rank, Work&& work) {
+  try {
+    work();
+  } catch (const cosserat::SceneError& e) {
+    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadInput;
+  } catch (const cosserat::DecompositionError& e) {
+    if (rank == 0) fmt::print(stderr, "error: {}: {}\n", scene_path, e.what());
+    return kExitBadInput;
+  }
+  return std::nullopt;
+}
+
 int run(const RunOptions& options, int rank, int ranks) {
   using namespace cosserat;
   Scene scene;
   std::optional<Decomposition> decomposition;
-  try {
-    scene = load_scene(options.scene_path, options.overrides);
-    decomposition = Decomposition::choose(scene.m, scene.n, ranks);
-  } catch (const SceneError& e) {
-    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
-    return kExitBadInput;
-  } catch (const DecompositionError& e) {
-    if (rank == 0) fmt::print(stderr, "error: {}: {}\n", options.scene_path, e.what());
-    return kExitBadInput;
-  }
+  if (const auto status = bad_input(options.scene_path, rank, [&] {
+        scene = load_scene(options.scene_path, options.overrides);
+        decomposition = Decomposition::choose(scene.m, scene.n, ranks);
+      }))
+    return *status;
   if (rank == 0)
     for (const std::string& warning : scene.warnings) fmt::print(stderr, "warning: {}\n", warning);
   if (!fits_in_memory(scene, decomposition->block(rank, MPI_COMM_WORLD), rank))
@@ -143,12 +154,10 @@ int run(const RunOptions& options, int rank, int ranks) {
 
   // The semi-implicit baseline checks its solver names with PETSc while it is set up.
   std::unique_ptr<Simulation> simulation_owner;
-  try {
-    simulation_owner = std::make_unique<Simulation>(scene, MPI_COMM_WORLD, *decomposition);
-  } catch (const SceneError& e) {
-    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
-    return kExitBadInput;
-  }
+  if (const auto status = bad_input(options.scene_path, rank, [&] {
+        simulation_owner = std::make_unique<Simulation>(scene, MPI_COMM_WORLD, *decomposition);
+      }))
+    return *status;
   Simulation& simulation = *simulation_owner;
   std::optional<long> restarted_from;
   if (!options.restart.empty()) {
@@ -265,11 +274,7 @@ int run(const RunOptions& options, int rank, int ranks) {
   summary.kinetic_energy = diagnostics.kinetic_energy;
   summary.center_of_mass = diagnostics.center_of_mass;
   summary.output = output;
-  if (const auto solves = simulation.stepper().linear_solves()) {
-    summary.linear_solves = LinearSolveSummary{solves->solves, solves->iterations,
-                                               solves->most_iterations, solves->jacobian_seconds,
-                                               solves->solve_seconds};
-  }
+  summary.linear_solves = simulation.stepper().linear_solves();
   summary.rest = rest;
   if (rank == 0) {
     if (!options.summary.empty()) write_summary(options.summary, summary);
@@ -298,7 +303,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
   if (integrators.size() == 1 && integrators[0] == "all") integrators = integrator_names();
   std::vector<Scene> scenes;
   double duration = 0.0;
-  try {
+  const auto status = bad_input(options.scene_path, rank, [&] {
     const Scene base = load_scene(options.scene_path, options.overrides);
     if (integrators.empty()) integrators.push_back(integrator_name(base.integrator));
     duration = options.duration.value_or(static_cast<double>(base.steps) * base.dt);
@@ -311,13 +316,8 @@ int stable_dt(const StableDtOptions& options, int rank) {
       scenes.push_back(load_scene(options.scene_path, overrides));
     }
     Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
-  } catch (const SceneError& e) {
-    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
-    return kExitBadInput;
-  } catch (const DecompositionError& e) {
-    if (rank == 0) fmt::print(stderr, "error: {}: {}\n", options.scene_path, e.what());
-    return kExitBadInput;
-  }
+  });
+  if (status) return *status;
 
   const Scene& first = scenes.front();
   const CflEstimate cfl = cfl_estimate(first);
@@ -336,17 +336,16 @@ int stable_dt(const StableDtOptions& options, int rank) {
   for (const Scene& scene : scenes) {
     const std::string name = integrator_name(scene.integrator);
     StableStep found;
-    try {
-      found = largest_stable_step(scene, duration, options.tolerance, MPI_COMM_WORLD,
-                                  [&](const StabilityTrial& t) {
-                                    if (rank == 0 && !options.quiet)
-                                      fmt::print(stderr, "  {} dt = {:.6g}: {}\n", name, t.dt,
-                                                 t.stable ? "stable" : "unstable, " + t.cause);
-                                  });
-    } catch (const SceneError& e) {
-      if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
-      return kExitBadInput;
-    }
+    const auto report = [&](const StabilityTrial& t) {
+      if (rank == 0 && !options.quiet)
+        fmt::print(stderr, "  {} dt = {:.6g}: {}\n", name, t.dt,
+                   t.stable ? "stable" : "unstable, " + t.cause);
+    };
+    // The semi-implicit solver's names are checked by PETSc when its first trial sets it up.
+    if (const auto failed = bad_input(options.scene_path, rank, [&] {
+          found = largest_stable_step(scene, duration, options.tolerance, MPI_COMM_WORLD, report);
+        }))
+      return *failed;
     double wall = 0.0;
     std::string cause;
     for (const StabilityTrial& t : found.trials) {

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "cosserat/baseline/linear_solve_stats.hpp"
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/scene/scene.hpp"
@@ -24,16 +25,6 @@
 #include "cosserat/time/dynamics.hpp"
 
 namespace cosserat {
-
-// What the linear solves cost so far, on this rank (the run summary reports
-// rank 0's; every rank takes part in every solve).
-struct LinearSolveStats {
-  long solves = 0;
-  long iterations = 0;       // summed over the solves
-  long most_iterations = 0;  // in one solve
-  double jacobian_seconds = 0.0;
-  double solve_seconds = 0.0;
-};
 
 class SemiImplicitSolver {
  public:

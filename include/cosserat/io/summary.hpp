@@ -5,18 +5,10 @@
 #include <optional>
 #include <string>
 
+#include "cosserat/baseline/linear_solve_stats.hpp"
 #include "cosserat/model/vec3.hpp"
 
 namespace cosserat {
-
-// The semi-implicit baseline's linear solves over the run (rank 0's timings).
-struct LinearSolveSummary {
-  long solves = 0;
-  long iterations = 0;
-  long most_iterations = 0;
-  double jacobian_seconds = 0.0;
-  double solve_seconds = 0.0;
-};
 
 // When a run stopped at rest (--until-rest): kinetic energy below `fraction` of its peak.
 struct RestSummary {
@@ -47,7 +39,7 @@ struct RunSummary {
   double kinetic_energy = 0.0;
   Vec3 center_of_mass;
   std::string output;  // the HDF5 file written
-  std::optional<LinearSolveSummary> linear_solves;  // semi-implicit only
+  std::optional<LinearSolveStats> linear_solves;  // semi-implicit only
   std::optional<RestSummary> rest;                  // with --until-rest only
 };
 
