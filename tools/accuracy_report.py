@@ -133,17 +133,21 @@ def main():
             "Bisection to 2 % on the stability monitor (`cosserat stable-dt --time T`). "
             "`≥` : stable up to Δt = T, the search's ceiling. Exit status of every "
             "`stable-dt` call: " + ", ".join(sorted({r["exit_status"] for r in stability}))
-            + " (0: finished; every blow-up was stopped by the monitor).", "",
+            + " (0: finished; every blow-up was stopped by the monitor; timeout: the search "
+            "ran past the study's `--timeout` and was stopped, its cell says so).", "",
             "| case | T (s) | CFL est. | " + " | ".join(SCHEMES) + " |",
             "|---|---|---|" + "---|" * len(SCHEMES)]
     for case in cases:
         rows = {r["integrator"]: r for r in stability if r["case"] == case}
-        first = next(iter(rows.values()))
+        first = next((r for r in rows.values() if r["cfl_dt"]), next(iter(rows.values())))
         cells = []
         for s in SCHEMES:
             r = rows.get(s)
             if r is None:
                 cells.append("not run")
+                continue
+            if r["exit_status"] == "timeout":
+                cells.append(r["cause"])
                 continue
             dt, ratio = number(r["stable_dt"]), number(r["stable_over_cfl"])
             bound = "≥ " if number(r["unstable_dt"]) == 0 else ""

@@ -14,6 +14,7 @@ single-threaded processes side by side. See docs/integrator-study.md for the def
 import argparse
 import concurrent.futures
 import csv
+import datetime
 import json
 import math
 import os
@@ -28,6 +29,9 @@ import numpy as np
 
 SCHEMES = ["verlet", "symplectic-euler", "euler", "midpoint", "rk4", "leapfrog",
            "velocity-verlet", "tc-verlet", "verlet-lagged", "semi-implicit"]
+SLOW_FIRST = ["euler", "semi-implicit", "midpoint", "rk4"]
+STABILITY_KEYS = ["scene", "integrator", "duration", "stable_dt", "unstable_dt", "cfl_dt",
+                  "stable_over_cfl", "trials", "wall_seconds", "cause", "case", "exit_status"]
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "scenes"
 
@@ -45,7 +49,12 @@ class Study:
         self.env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
                         OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
         self.quick = args.quick
-        self.log = open(str(self.out) + ".log", "w")
+        self.timeout = args.timeout
+        self.max_node_steps = args.max_node_steps
+        # Appended to: the study can be run a part or a case at a time (--parts, --cases).
+        self.log = open(str(self.out) + ".log", "a")
+        self.say(f"# {datetime.datetime.now().isoformat(timespec='seconds')}: "
+                 + " ".join(sys.argv[1:]))
 
     def say(self, text):
         print(text, flush=True)
@@ -71,17 +80,23 @@ class Study:
     # ------------------------------------------------------------------------------------------
     # Stability
 
-    def stable_dt(self, case):
-        """One `cosserat stable-dt` call: case = (label, scene, overrides, T, schemes)."""
-        label, scene, overrides, duration, schemes = case
-        csv_path = self.work / f"stable-{file_name(label)}.csv"
+    def stable_dt(self, job):
+        """One `cosserat stable-dt` call for one scheme: job = (label, scene, overrides, T,
+        scheme). A call that runs past the timeout leaves a row that says so."""
+        label, scene, overrides, duration, scheme = job
+        csv_path = self.work / f"stable-{file_name(label)}-{scheme}.csv"
         command = [self.exe, "stable-dt", scene, "--time", str(duration), "-q",
-                   "--csv", str(csv_path)]
-        for s in schemes:
-            command += ["--integrator", s]
+                   "--csv", str(csv_path), "--integrator", scheme]
         for o in overrides:
             command += ["--set", o]
-        done = subprocess.run(command, env=self.env, capture_output=True, text=True)
+        try:
+            done = subprocess.run(command, env=self.env, capture_output=True, text=True,
+                                  timeout=self.timeout)
+        except subprocess.TimeoutExpired:
+            row = dict.fromkeys(STABILITY_KEYS, "")
+            row.update(integrator=scheme, duration=duration, case=label, exit_status="timeout",
+                       cause=f"timed out after {self.timeout:g} s")
+            return label, scheme, "timeout", "", [row]
         rows = []
         if csv_path.exists():
             with open(csv_path) as f:
@@ -89,17 +104,24 @@ class Study:
                     row["case"] = label
                     row["exit_status"] = done.returncode
                     rows.append(row)
-        return label, done.returncode, done.stdout + done.stderr, rows
+        return label, scheme, done.returncode, done.stdout + done.stderr, rows
 
     def stability(self, cases):
+        # One process per case and scheme, the slow schemes first so that the two workers end
+        # together.
+        jobs = [(label, scene, overrides, duration, scheme)
+                for label, scene, overrides, duration, schemes in cases for scheme in schemes]
+        jobs.sort(key=lambda job: SLOW_FIRST.index(job[4]) if job[4] in SLOW_FIRST else 99)
         rows = []
         with concurrent.futures.ThreadPoolExecutor(self.workers) as pool:
-            for label, status, text, case_rows in pool.map(self.stable_dt, cases):
-                self.say(f"stable-dt {label}: exit {status}\n{text.strip()}")
+            for label, scheme, status, text, job_rows in pool.map(self.stable_dt, jobs):
+                self.say(f"stable-dt {label} {scheme}: exit {status}\n{text.strip()}")
                 if status != 0:
-                    self.say(f"  !! stable-dt {label} did not finish cleanly (exit {status})")
-                rows += case_rows
-        return rows
+                    self.say(f"  !! stable-dt {label} {scheme} did not finish cleanly "
+                             f"(exit {status})")
+                rows += job_rows
+        order = {(c[0], s): i for i, (c, s) in enumerate((c, s) for c in cases for s in c[4])}
+        return sorted(rows, key=lambda r: order[(r["case"], r["integrator"])])
 
     # ------------------------------------------------------------------------------------------
     # Runs
@@ -135,16 +157,17 @@ class Study:
     # ------------------------------------------------------------------------------------------
     # Accuracy
 
-    def accuracy(self, label, scene, duration, limits, levels, size):
-        """Sweep each scheme from its stable limit down by halves; error against RK4."""
-        jobs = []
+    def accuracy(self, label, scene, duration, limits, levels, size, nodes):
+        """Sweep each scheme from its stable limit down by halves; error against RK4. A run of
+        more than max_node_steps (steps x nodes) is left out and listed as such."""
+        jobs, skipped = [], []
         for scheme in SCHEMES:
             limit = limits.get(scheme, 0.0)
             if not limit > 0.0:
                 continue
             for j in range(levels):
                 steps = math.ceil(duration / (limit / 2 ** j) - 1e-9)
-                jobs.append((scheme, steps))
+                (jobs if steps * nodes <= self.max_node_steps else skipped).append((scheme, steps))
         smallest = duration / max(steps for _, steps in jobs)
         # The reference: RK4 at 1/8 of the smallest swept step, but no finer than 1/256 of its
         # own limit, where its error is at round-off (the Richardson estimate below says so):
@@ -170,7 +193,10 @@ class Study:
         reference = reference_jobs[0][3]
         reference_error = rms(reference_jobs[1][3] - reference, size) / 15.0
         self.say(f"{label}: reference's own error (Richardson, order 4): {reference_error:.2e}")
-        rows = []
+        rows = [{"scene": label, "integrator": scheme, "dt": duration / steps, "steps": steps,
+                 "wall_seconds": None, "error": None,
+                 "status": f"not run: {steps * nodes:.3g} node-steps > --max-node-steps",
+                 "reference_error": reference_error} for scheme, steps in skipped]
         for scheme, steps, summary, positions in results:
             error = rms(positions - reference, size) if positions is not None else float("nan")
             rows.append({"scene": label, "integrator": scheme, "dt": duration / steps,
@@ -227,18 +253,30 @@ def rms(difference, size):
     return float(np.sqrt(np.mean(np.sum(difference ** 2, axis=1)))) / size
 
 
-def write_csv(path, rows):
+def write_csv(path, rows, key=None):
+    """Writes rows to path; with key, rows already there whose key is not among the new rows'
+    are kept, so that the study can be run a part or a case at a time."""
+    if key and Path(path).exists():
+        with open(path) as f:
+            new = {r[key] for r in rows}
+            rows = [r for r in csv.DictReader(f) if r[key] not in new] + rows
     if not rows:
         return
-    keys = list(rows[0].keys())
+    keys = list(dict.fromkeys(k for r in rows for k in r))
     with open(path, "w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
         writer.writeheader()
         writer.writerows(rows)
 
 
+def nodes_of(scene):
+    n = re.search(r"^nodes\s*=\s*\[\s*(\d+)\s*,\s*(\d+)\s*\]", Path(scene).read_text(), re.M)
+    return int(n.group(1)) * int(n.group(2))
+
+
 def limits_of(rows, case):
-    return {r["integrator"]: float(r["stable_dt"]) for r in rows if r["case"] == case}
+    return {r["integrator"]: float(r["stable_dt"]) for r in rows
+            if r["case"] == case and r["stable_dt"]}
 
 
 def main():
@@ -252,6 +290,12 @@ def main():
     parser.add_argument("--accuracy-scenes", default="S1,S2,hanging",
                         help="scenes of the speed-against-error sweep")
     parser.add_argument("--rest-scenes", default="S1,S2,S3,S5")
+    parser.add_argument("--cases", help="stability cases to run, by label (default: all); the "
+                        "rows of other cases already in the CSV are kept")
+    parser.add_argument("--timeout", type=float, default=3600.0,
+                        help="wall seconds one stable-dt search of one scheme may take")
+    parser.add_argument("--max-node-steps", type=float, default=2e9,
+                        help="largest run of the accuracy sweep, in steps x nodes")
     args = parser.parse_args()
     study = Study(args)
     parts = args.parts.split(",")
@@ -294,13 +338,17 @@ def main():
         (f"S1 {big_nodes}x{big_nodes}", hanging(big_nodes), [], T_fine / 2,
          [s for s in SCHEMES if s not in ("euler", "semi-implicit")]),
     ]
+    if args.cases:
+        chosen = args.cases.split(",")
+        unknown = set(chosen) - {c[0] for c in cases}
+        if unknown:
+            parser.error(f"unknown cases {sorted(unknown)}; known: {[c[0] for c in cases]}")
+        cases = [c for c in cases if c[0] in chosen]
     stem = str(study.out)
     if "stability" in parts:
-        stability_rows = study.stability(cases)
-        write_csv(stem + "-stability.csv", stability_rows)
-    else:
-        with open(stem + "-stability.csv") as f:
-            stability_rows = list(csv.DictReader(f))
+        write_csv(stem + "-stability.csv", study.stability(cases), key="case")
+    with open(stem + "-stability.csv") as f:
+        stability_rows = list(csv.DictReader(f))
 
     if "accuracy" in parts:
         accuracy_rows = []
@@ -312,8 +360,9 @@ def main():
                 continue
             levels = 4 if label.startswith("hanging") else 6
             accuracy_rows += study.accuracy(label, scene, duration,
-                                            limits_of(stability_rows, label), levels, 10.0)
-            write_csv(stem + "-accuracy.csv", accuracy_rows)
+                                            limits_of(stability_rows, label), levels, 10.0,
+                                            nodes_of(scene))
+            write_csv(stem + "-accuracy.csv", accuracy_rows, key="scene")
 
     if "rest" in parts:
         rest_rows = []
@@ -322,7 +371,7 @@ def main():
                                     limits_of(stability_rows, label),
                                     longest=10.0 if quick else 30.0,
                                     timeout=60 if quick else 120)
-            write_csv(stem + "-rest.csv", rest_rows)
+            write_csv(stem + "-rest.csv", rest_rows, key="scene")
 
 
 if __name__ == "__main__":
