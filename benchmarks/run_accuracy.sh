@@ -4,10 +4,10 @@
 # hanging sheet, and time to rest on S1, S2, S3, S5. Writes
 # benchmarks/results/accuracy-<host>-<date>{-stability,-accuracy,-rest}.csv, the plots
 # (-work-precision.png, -error-vs-dt.png), the summary (.md) and the log of every run (.log).
-# Some three hours on two cores (docs/integrator-study.md); --quick checks the pipeline in a
-# few minutes. A part or some cases at a time merge into the files already there:
+# About four hours on two cores (docs/integrator-study.md); --quick checks the pipeline in a
+# few minutes. A part, some cases or some schemes at a time merge into the files already there:
 #   benchmarks/run_accuracy.sh [--quick] [--parts stability,accuracy,rest] [--cases "S1,S6 xi=0"]
-#                              [--accuracy-scenes S1,S2,hanging] [--timeout SECONDS]
+#       [--schemes verlet,rk4] [--accuracy-scenes S1,S2,hanging] [--timeout SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source benchmarks/context.sh accuracy release cosserat

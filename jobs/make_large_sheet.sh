@@ -3,8 +3,8 @@
 # two corners of one edge, gravity, damping 0.2, Verlet) on a NODES x NODES grid to FILE.
 # S1's own file names its corners by index for its 10 x 10 grid; here they follow NODES. The
 # step is 0.02 h²: on fine grids bending sets the largest stable Verlet step, which shrinks
-# with h² (docs/stability.md); S1's is about 0.045 h² (0.0124 s at h = 10/9 m,
-# `cosserat stable-dt`).
+# with h² (docs/stability.md): measured 0.071 h² on 120 x 120 and 240 x 240
+# (`cosserat stable-dt`, docs/integrator-study.md), so 0.02 h² keeps a margin of 3.5.
 #   jobs/make_large_sheet.sh NODES STEPS FILE
 set -euo pipefail
 nodes=$1
