@@ -52,13 +52,19 @@ class Study:
         self.quick = args.quick
         self.timeout = args.timeout
         self.max_node_steps = args.max_node_steps
-        # Appended to: the study can be run a part or a case at a time (--parts, --cases).
+        self.log = None
+
+    def start(self):
+        """Opens the log, appended to: the study can be run a piece at a time (--parts, --cases,
+        --schemes)."""
         self.log = open(str(self.out) + ".log", "a")
         self.say(f"# {datetime.datetime.now().isoformat(timespec='seconds')}: "
                  + " ".join(sys.argv[1:]))
 
     def say(self, text):
         print(text, flush=True)
+        if self.log is None:
+            self.start()
         self.log.write(text + "\n")
         self.log.flush()
 
@@ -340,21 +346,26 @@ def main():
         (f"S1 {big_nodes}x{big_nodes}", hanging(big_nodes), [], T_fine / 2,
          [s for s in SCHEMES if s != "semi-implicit"]),
     ]
+    def refuse(message):  # before any run and before the log is touched
+        shutil.rmtree(study.work, ignore_errors=True)
+        parser.error(message)
+
     if args.cases:
         chosen = args.cases.split(",")
         unknown = set(chosen) - {c[0] for c in cases}
         if unknown:
-            parser.error(f"unknown cases {sorted(unknown)}; known: {[c[0] for c in cases]}")
+            refuse(f"unknown cases {sorted(unknown)}; known: {[c[0] for c in cases]}")
         cases = [c for c in cases if c[0] in chosen]
     if args.schemes:
         chosen = args.schemes.split(",")
         unknown = set(chosen) - set(SCHEMES)
         if unknown:
-            parser.error(f"unknown schemes {sorted(unknown)}; known: {SCHEMES}")
+            refuse(f"unknown schemes {sorted(unknown)}; known: {SCHEMES}")
         cases = [c[:4] + ([s for s in c[4] if s in chosen],) for c in cases]
     if not any(c[4] for c in cases):
-        parser.error("--cases and --schemes leave no stable-dt search to run")
+        refuse("--cases and --schemes leave no stable-dt search to run")
     stem = str(study.out)
+    study.start()
     if "stability" in parts:
         write_csv(stem + "-stability.csv", study.stability(cases), key=("case", "integrator"))
     with open(stem + "-stability.csv") as f:
