@@ -12,7 +12,6 @@
 
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
-#include "cosserat/model/wave_speed.hpp"
 #include "mpi_support.hpp"
 #include "support/dataset_bytes.hpp"
 #include "support/sheets.hpp"
@@ -92,10 +91,7 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
 // (test_semi_implicit.cpp).
 TEST_F(Restart, SemiImplicitContinuesOnAnotherSplitAndOnOneRank) {
   const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
-  Scene scene = testing::odd_grid_scene(Integrator::semi_implicit);
-  scene.dt = 2.0 * cfl_estimate(scene).dt;
-  scene.steps = 40;
-  scene.solver.rtol = 1e-12;
+  const Scene scene = testing::semi_implicit_odd_grid_scene();
   const long half = scene.steps / 2;
   const auto splits = all_splits(scene.m, scene.n, world_size());
   Simulation uninterrupted(scene, MPI_COMM_SELF);

@@ -7,7 +7,6 @@
 
 #include <cstdio>
 
-#include "cosserat/model/wave_speed.hpp"
 #include "mpi/mpi_support.hpp"
 #include "support/sheets.hpp"
 
@@ -20,10 +19,7 @@ namespace {
 // borders, a load, fluid and damping) at twice the explicit limit, so the
 // Jacobian carries the step.
 TEST(SemiImplicitDecomposition, EverySplitFollowsTheOneBlockTrajectory) {
-  Scene scene = testing::odd_grid_scene(Integrator::semi_implicit);
-  scene.dt = 2.0 * cfl_estimate(scene).dt;
-  scene.steps = 40;
-  scene.solver.rtol = 1e-12;
+  const Scene scene = testing::semi_implicit_odd_grid_scene();
   Simulation reference(scene, MPI_COMM_SELF);
   const Simulation start(scene, MPI_COMM_SELF);
   ASSERT_TRUE(testing::advance(reference, scene.steps));
