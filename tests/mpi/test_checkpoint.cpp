@@ -47,26 +47,37 @@ class SharedFolder : public ::testing::Test {
   fs::path folder_;
 };
 
-using Restart = SharedFolder;
+// Checkpoint at half the scene's steps on all ranks, then continue from the file.
+class Restart : public SharedFolder {
+ protected:
+  std::string checkpoint() const { return (folder_ / "run.checkpoint.h5").string(); }
+
+  // Runs `scene` on all ranks, split as the driver splits it, to half its steps and writes the
+  // checkpoint.
+  void checkpoint_at_half(const Scene& scene) const {
+    Simulation first(scene, MPI_COMM_WORLD);
+    ASSERT_TRUE(testing::advance(first, scene.steps / 2));
+    write_checkpoint(checkpoint(), first, scene, "test");
+  }
+
+  // Reads the checkpoint into `sim` (any split, any communicator) and runs it to the end.
+  void continue_to_end(Simulation& sim, const Scene& scene) const {
+    EXPECT_EQ(read_checkpoint(checkpoint(), sim, scene), scene.steps / 2);
+    ASSERT_TRUE(testing::advance(sim, scene.steps - scene.steps / 2));
+    EXPECT_EQ(sim.step_index(), scene.steps);
+  }
+};
 
 TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
-  const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
   for (const Integrator integrator : explicit_integrators()) {
     const Scene scene = testing::odd_grid_scene(integrator);  // 80 steps
-    const long half = scene.steps / 2;
     const auto splits = all_splits(scene.m, scene.n, world_size());
     Simulation uninterrupted(scene, MPI_COMM_SELF);  // one block: the comparisons' reference
     ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
 
-    {
-      Simulation first(scene, MPI_COMM_WORLD);
-      ASSERT_TRUE(testing::advance(first, half));
-      write_checkpoint(checkpoint, first, scene, "test");
-    }
+    checkpoint_at_half(scene);
     Simulation other_split(scene, MPI_COMM_WORLD, splits.back());
-    EXPECT_EQ(read_checkpoint(checkpoint, other_split, scene), half);
-    ASSERT_TRUE(testing::advance(other_split, scene.steps - half));
-    EXPECT_EQ(other_split.step_index(), scene.steps);
+    continue_to_end(other_split, scene);
     EXPECT_EQ(differing_nodes(other_split.positions(), uninterrupted.positions()), 0)
         << integrator_name(integrator) << ", split " << testing::split_name(splits.back());
     EXPECT_EQ(differing_nodes(other_split.velocities(), uninterrupted.velocities()), 0)
@@ -74,8 +85,7 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
 
     // Every rank restarts the whole grid alone from the file the P ranks wrote.
     Simulation one_rank(scene, MPI_COMM_SELF);
-    EXPECT_EQ(read_checkpoint(checkpoint, one_rank, scene), half);
-    ASSERT_TRUE(testing::advance(one_rank, scene.steps - half));
+    continue_to_end(one_rank, scene);
     EXPECT_EQ(differing_nodes(one_rank.positions(), uninterrupted.positions()), 0)
         << integrator_name(integrator) << " restarted on one rank";
     EXPECT_EQ(differing_nodes(one_rank.velocities(), uninterrupted.velocities()), 0)
@@ -90,27 +100,19 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
 // not bitwise, since block Jacobi preconditions each split differently
 // (test_semi_implicit.cpp).
 TEST_F(Restart, SemiImplicitContinuesOnAnotherSplitAndOnOneRank) {
-  const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
   const Scene scene = testing::semi_implicit_odd_grid_scene();
-  const long half = scene.steps / 2;
   const auto splits = all_splits(scene.m, scene.n, world_size());
   Simulation uninterrupted(scene, MPI_COMM_SELF);
   ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
-  {
-    Simulation first(scene, MPI_COMM_WORLD);
-    ASSERT_TRUE(testing::advance(first, half));
-    write_checkpoint(checkpoint, first, scene, "test");
-  }
+  checkpoint_at_half(scene);
   Simulation other_split(scene, MPI_COMM_WORLD, splits.back());
-  EXPECT_EQ(read_checkpoint(checkpoint, other_split, scene), half);
-  ASSERT_TRUE(testing::advance(other_split, scene.steps - half));
+  continue_to_end(other_split, scene);
   // As in test_semi_implicit.cpp: 40 solves to 1e-12 of |δ| stay far below 1e-9 m.
   EXPECT_LT(testing::largest_difference(other_split.positions(), uninterrupted.positions()), 1e-9)
       << "split " << testing::split_name(splits.back());
 
   Simulation one_rank(scene, MPI_COMM_SELF);
-  EXPECT_EQ(read_checkpoint(checkpoint, one_rank, scene), half);
-  ASSERT_TRUE(testing::advance(one_rank, scene.steps - half));
+  continue_to_end(one_rank, scene);
   EXPECT_LT(testing::largest_difference(one_rank.positions(), uninterrupted.positions()), 1e-9)
       << "restarted on one rank";
 }
