@@ -320,7 +320,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
   if (status) return *status;
 
   const Scene& first = scenes.front();
-  const CflEstimate cfl = cfl_estimate(first);
+  const CflEstimate cfl = cfl_estimate(first.material, first.areal_density(), first.h1(), first.h2());
   const std::string title = first.title.empty() ? first.name : first.title;
   if (rank == 0) {
     fmt::print("{}: {} x {} nodes, stable over T = {} s, to {:.3g} %; CFL estimate {:.4g} s "

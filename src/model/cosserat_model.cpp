@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include "cosserat/scene/scene.hpp"
-
 // Reach of the stencil (MODEL.md §2.4), which sizes the ghost layer (kGhostWidth = 2):
 //  - resultants at p read positions in the 3x3 box around p;
 //  - traction T^1 at p reads resultants at p, p+e1 (∂_1 M^11) and p-e2 (∂_2 M^12);

@@ -12,10 +12,8 @@ namespace cosserat {
 // has wave number π/h, where the compact second difference is 4/h² and the
 // fourth 16/h⁴; central differences are stable while ω Δt ≤ 2
 // (docs/stability.md).
-CflEstimate cfl_estimate(const Scene& scene) {
-  const Material& m = scene.material;
-  const double density = m.mass / (scene.size1 * scene.size2);
-  const double h[2] = {scene.h1(), scene.h2()};
+CflEstimate cfl_estimate(const Material& m, double density, double h1, double h2) {
+  const double h[2] = {h1, h2};
   CflEstimate e{};
   e.membrane_dt = std::numeric_limits<double>::infinity();
   e.bending_dt = std::numeric_limits<double>::infinity();

@@ -86,7 +86,7 @@ TEST(SemiImplicit, HeldComponentsStay) {
 // is stopped by the monitor. The Jacobian must be right for this, not just present.
 TEST(SemiImplicit, StableBeyondTheExplicitLimit) {
   Scene scene = load_scene(std::string(COSSERAT_SOURCE_DIR) + "/scenes/s1_clothesline.toml");
-  scene.dt = 3.0 * cfl_estimate(scene).dt;
+  scene.dt = 3.0 * cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2()).dt;
   const long steps = std::lround(3.0 / scene.dt);
   scene.integrator = Integrator::verlet;
   Simulation verlet(scene, MPI_COMM_SELF);

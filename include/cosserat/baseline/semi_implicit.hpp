@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-#include "cosserat/baseline/linear_solve_stats.hpp"
+#include "cosserat/time/linear_solve_stats.hpp"
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/scene/scene.hpp"

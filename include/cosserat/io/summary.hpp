@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "cosserat/baseline/linear_solve_stats.hpp"
+#include "cosserat/time/linear_solve_stats.hpp"
 #include "cosserat/model/vec3.hpp"
 
 namespace cosserat {

@@ -5,12 +5,12 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/reduce.hpp"
+#include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/model/vec3.hpp"
 
 namespace cosserat {
 
-enum class Borders;
 
 // Rest data of a flat sheet: uniform, so kept as constants (MODEL.md §3).
 struct RestState {

@@ -3,7 +3,7 @@
 // (docs/stability.md): the CFL estimate beside which `cosserat stable-dt`
 // reports the measured limits.
 
-#include "cosserat/scene/scene.hpp"
+#include "cosserat/model/material.hpp"
 
 namespace cosserat {
 
@@ -16,6 +16,7 @@ struct CflEstimate {
   double dt;                  // the smaller of the two
 };
 
-CflEstimate cfl_estimate(const Scene& scene);
+// For areal density μ (kg/m²) and grid spacings h1, h2 (m).
+CflEstimate cfl_estimate(const Material& material, double density, double h1, double h2);
 
 }  // namespace cosserat

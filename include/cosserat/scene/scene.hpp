@@ -9,8 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/model/vec3.hpp"
+#include "cosserat/time/integrator.hpp"
 
 namespace cosserat {
 
@@ -19,26 +21,6 @@ class SceneError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
-
-enum class Integrator {
-  verlet,
-  symplectic_euler,
-  euler,
-  midpoint,
-  rk4,
-  leapfrog,
-  velocity_verlet,
-  tc_verlet,
-  verlet_lagged,
-  semi_implicit,  // the PETSc baseline; only in builds with PETSc
-};
-
-// Names as written in scene files, in the order of the enum.
-const std::vector<std::string>& integrator_names();
-std::optional<Integrator> integrator_from_name(const std::string& name);
-const std::string& integrator_name(Integrator integrator);
-
-enum class Borders { symmetric, published };
 
 struct NodeIndex {
   int k = 0;
@@ -125,6 +107,7 @@ struct Scene {
 
   double h1() const { return size1 / (m - 1); }
   double h2() const { return size2 / (n - 1); }
+  double areal_density() const { return material.mass / (size1 * size2); }  // μ0, kg/m²
 };
 
 // Reads and validates a scene file. `overrides` are "dotted.key=toml-value" strings applied

@@ -1,0 +1,49 @@
+#pragma once
+// The time integrators by name (MODEL.md §4). Header-only on purpose: the scene loader, one
+// module below `time`, checks the name a scene gives before any work (exit 2), and a header
+// of names and an enum is vocabulary, not code to link.
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace cosserat {
+
+enum class Integrator {
+  verlet,
+  symplectic_euler,
+  euler,
+  midpoint,
+  rk4,
+  leapfrog,
+  velocity_verlet,
+  tc_verlet,
+  verlet_lagged,
+  semi_implicit,  // the PETSc baseline; only in builds with PETSc
+};
+
+// Names as written in scene files, in the order of the enum.
+inline const std::vector<std::string>& integrator_names() {
+  static const std::vector<std::string> names{
+      "verlet",   "symplectic-euler", "euler",     "midpoint",      "rk4",
+      "leapfrog", "velocity-verlet",  "tc-verlet", "verlet-lagged", "semi-implicit",
+  };
+  return names;
+}
+
+inline std::optional<Integrator> integrator_from_name(const std::string& name) {
+  const auto& names = integrator_names();
+  const auto found = std::find(names.begin(), names.end(), name);
+  if (found == names.end()) return std::nullopt;
+  return static_cast<Integrator>(found - names.begin());
+}
+
+inline const std::string& integrator_name(Integrator integrator) {
+  return integrator_names().at(static_cast<std::size_t>(integrator));
+}
+
+}  // namespace cosserat
