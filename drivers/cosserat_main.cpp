@@ -155,7 +155,8 @@ int run(const RunOptions& options, int rank, int ranks) {
   // The semi-implicit baseline checks its solver names with PETSc while it is set up.
   std::unique_ptr<Simulation> simulation_owner;
   if (const auto status = bad_input(options.scene_path, rank, [&] {
-        simulation_owner = std::make_unique<Simulation>(scene, MPI_COMM_WORLD, *decomposition);
+        simulation_owner = std::make_unique<Simulation>(scene, MPI_COMM_WORLD, *decomposition,
+                                                        any_scheme);
       }))
     return *status;
   Simulation& simulation = *simulation_owner;
@@ -343,7 +344,8 @@ int stable_dt(const StableDtOptions& options, int rank) {
     };
     // The semi-implicit solver's names are checked by PETSc when its first trial sets it up.
     if (const auto failed = bad_input(options.scene_path, rank, [&] {
-          found = largest_stable_step(scene, duration, options.tolerance, MPI_COMM_WORLD, report);
+          found = largest_stable_step(scene, duration, options.tolerance, MPI_COMM_WORLD,
+                                      any_scheme, report);
         }))
       return *failed;
     double wall = 0.0;

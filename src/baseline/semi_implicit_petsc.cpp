@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "cosserat/baseline/semi_implicit.hpp"
+#include "semi_implicit_solver.hpp"
 
 namespace cosserat {
 
@@ -229,7 +230,8 @@ void SemiImplicitSolver::linearise(const Field<Vec3>& r) {
 }
 
 std::optional<std::string> SemiImplicitSolver::solve(
-    const VelocityTerms& terms, const Field<Vec3>& rhs, const Field<Vec3>& guess,
+    const VelocityTerms& terms, const Field<Vec3>* normals, const Field<Vec3>& rhs,
+    const Field<Vec3>& guess,
     const std::vector<Constraints::NodeState>& held, Field<Vec3>& delta) {
   Impl& s = *impl_;
   const Block& bl = *s.block;
@@ -245,7 +247,7 @@ std::optional<std::string> SemiImplicitSolver::solve(
     const double weight = terms.fluid / (2.0 * dt);
     for (int l = bl.l0; l < bl.l1; ++l)
       for (int k = bl.k0; k < bl.k1; ++k) {
-        const Vec3 n = s.dynamics->normal(k, l);
+        const Vec3 n = (*normals)(k, l);
         MatStencil node[3];
         PetscScalar block[9];
         for (int a = 0; a < 3; ++a) {

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "surface_geometry.hpp"
+
 // Reach of the stencil (MODEL.md §2.4), which sizes the ghost layer (kGhostWidth = 2):
 //  - resultants at p read positions in the 3x3 box around p;
 //  - traction T^1 at p reads resultants at p, p+e1 (∂_1 M^11) and p-e2 (∂_2 M^12);
@@ -47,110 +49,84 @@ CosseratModel::CosseratModel(const Block& block, double h1, double h2, const Res
       traction1_(block),
       traction2_(block) {}
 
+namespace {
+
+// N*^{αβ} = 2Φ^{αβ} ε_αβ + Θ^{αβ} κ_αβ and M^{αβ} = 2Ψ^{αβ} κ_αβ + Θ^{αβ} ε_αβ with f = 1 (§1:
+// the corrected form of M), each as {11, 12, 22}.
+struct Resultants {
+  Sym2 N_star, M;
+};
+
+inline Resultants constitutive(const RestState& rest, const Sym2& epsilon, const Sym2& kappa) {
+  const Sym2 &Phi = rest.Phi, &Psi = rest.Psi, &Theta = rest.Theta;
+  return {{2.0 * Phi[0] * epsilon[0] + Theta[0] * kappa[0],
+           2.0 * Phi[1] * epsilon[1] + Theta[1] * kappa[1],
+           2.0 * Phi[2] * epsilon[2] + Theta[2] * kappa[2]},
+          {2.0 * Psi[0] * kappa[0] + Theta[0] * epsilon[0],
+           2.0 * Psi[1] * kappa[1] + Theta[1] * epsilon[1],
+           2.0 * Psi[2] * kappa[2] + Theta[2] * epsilon[2]}};
+}
+
+// §2.3 rules 1–2 on a border node: shear lives on cells, so the far borders carry none; a free
+// edge carries no bending moment about itself.
+inline void symmetric_border_rules(const geometry::Neighbours& p, Resultants& s) {
+  if (!p.right || !p.up) {
+    s.N_star[1] = 0.0;
+    s.M[1] = 0.0;
+  }
+  if (!p.left || !p.right) s.M[0] = 0.0;
+  if (!p.down || !p.up) s.M[2] = 0.0;
+}
+
+// Σ_β Σ_ρ (Γ^α_βρ M^{ρβ} + Γ^β_βρ M^{αρ}), the Γ·M part of N^{3α} (§1), for α = 1 and 2.
+inline double shear_christoffel1(const geometry::Christoffel& G, const Sym2& M) {
+  return G.G1_11 * M[0] + 2.0 * G.G1_12 * M[1] + G.G1_22 * M[2] + G.trace1() * M[0] +
+         G.trace2() * M[1];
+}
+inline double shear_christoffel2(const geometry::Christoffel& G, const Sym2& M) {
+  return G.G2_11 * M[0] + 2.0 * G.G2_12 * M[1] + G.G2_22 * M[2] + G.trace1() * M[1] +
+         G.trace2() * M[2];
+}
+
+}  // namespace
+
 // Geometry and stress resultants of node (k, l): MODEL.md §2.1 (with the §2.3 border rules
 // when they are on) and the constitutive law of §1 with f = 1.
 void CosseratModel::compute_resultants(const Field<Vec3>& R, int k, int l) {
-  const Block& b = *block_;
-  const bool has_left = k > 0, has_right = k < b.m - 1;
-  const bool has_down = l > 0, has_up = l < b.n - 1;
-  const double h1 = h1_, h2 = h2_;
-  const Vec3 r = R(k, l);
+  using namespace geometry;
+  const Neighbours p = neighbours(*block_, k, l);
+  const Tangents a = tangents(R, k, l, p, h1_, h2_);
+  const Vec3 n = unit_normal(R, k, l, p);
+  const SecondDerivatives d = second_derivatives(R, k, l, p, h1_, h2_);
+  const Metric g = metric(a);
+  const Sym2 b = curvature(n, d);
+  const Weingarten w = weingarten(g.upper, b);
+  const Christoffel G = christoffel(d, reciprocal_basis(a, g.upper));
 
-  // Tangents: forward differences, backward on the far border (§2.1 rule 1).
-  const Vec3 a1 = has_right ? (R(k + 1, l) - r) / h1 : (r - R(k - 1, l)) / h1;
-  const Vec3 a2 = has_up ? (R(k, l + 1) - r) / h2 : (r - R(k, l - 1)) / h2;
-
-  // Normal: normalised sum of the unit normals of the corner triangles present (§2.1 rule 2).
-  Vec3 normal_sum;
-  auto add_corner = [&](const Vec3& e, const Vec3& f) {
-    const Vec3 c = cross(e - r, f - r);
-    normal_sum += c / norm(c);
-  };
-  if (has_right && has_up) add_corner(R(k + 1, l), R(k, l + 1));
-  if (has_up && has_left) add_corner(R(k, l + 1), R(k - 1, l));
-  if (has_left && has_down) add_corner(R(k - 1, l), R(k, l - 1));
-  if (has_down && has_right) add_corner(R(k, l - 1), R(k + 1, l));
-  const Vec3 n = normal_sum / norm(normal_sum);
-
-  // Cross derivative on the nearest cell that exists: X++ inside, X-+ on B3, X+- on B4, X-- at
-  // C3 (§2.1 rule 3).
-  const int kc = has_right ? k : k - 1;
-  const int lc = has_up ? l : l - 1;
-  const Vec3 r12 =
-      (R(kc + 1, lc + 1) - R(kc + 1, lc) - R(kc, lc + 1) + R(kc, lc)) / (h1 * h2);
-  const Vec3 r11 =
-      has_left && has_right ? (R(k + 1, l) - 2.0 * r + R(k - 1, l)) / (h1 * h1) : r12;
-  const Vec3 r22 = has_down && has_up ? (R(k, l + 1) - 2.0 * r + R(k, l - 1)) / (h2 * h2) : r12;
-
-  // Metric, its inverse and the reciprocal basis (§1).
-  const double g11 = dot(a1, a1), g12 = dot(a1, a2), g22 = dot(a2, a2);
-  const double inv_det = 1.0 / (g11 * g22 - g12 * g12);
-  const double gi11 = g22 * inv_det, gi12 = -g12 * inv_det, gi22 = g11 * inv_det;
-  const Vec3 recip1 = gi11 * a1 + gi12 * a2;
-  const Vec3 recip2 = gi12 * a1 + gi22 * a2;
-
-  // Curvature b_ab and Weingarten map b^a_λ = a^{aρ} b_ρλ.
-  const double b11 = dot(n, r11), b12 = dot(n, r12), b22 = dot(n, r22);
-  const double w11 = gi11 * b11 + gi12 * b12, w12 = gi11 * b12 + gi12 * b22;
-  const double w21 = gi12 * b11 + gi22 * b12, w22 = gi12 * b12 + gi22 * b22;
-
-  // Strains: ε = ½(a − A), κ = −(b − B) with B = 0 for a flat rest sheet.
-  const Sym2& A = rest_.metric;
-  const double e11 = 0.5 * (g11 - A[0]), e12 = 0.5 * (g12 - A[1]), e22 = 0.5 * (g22 - A[2]);
-  const double c11 = -b11, c12 = -b12, c22 = -b22;
-
-  // Resultants N* and M (§1: M = 2Ψκ + Θε, the corrected form).
-  const Sym2 &Phi = rest_.Phi, &Psi = rest_.Psi, &Theta = rest_.Theta;
-  double Ns11 = 2.0 * Phi[0] * e11 + Theta[0] * c11;
-  double Ns12 = 2.0 * Phi[1] * e12 + Theta[1] * c12;
-  double Ns22 = 2.0 * Phi[2] * e22 + Theta[2] * c22;
-  double M11 = 2.0 * Psi[0] * c11 + Theta[0] * e11;
-  double M12 = 2.0 * Psi[1] * c12 + Theta[1] * e12;
-  double M22 = 2.0 * Psi[2] * c22 + Theta[2] * e22;
-
-  // Christoffel symbols Γ^λ_ab = r_,ab · a^λ and their traces C_a = Σ_λ Γ^λ_aλ.
-  const double G1_11 = dot(r11, recip1), G2_11 = dot(r11, recip2);
-  const double G1_12 = dot(r12, recip1), G2_12 = dot(r12, recip2);
-  const double G1_22 = dot(r22, recip1), G2_22 = dot(r22, recip2);
-  const double trace1 = G1_11 + G2_12, trace2 = G1_12 + G2_22;
-
-  const bool on_border = !(has_left && has_right && has_down && has_up);
-  if (symmetric_borders_) {
-    // §2.3 rule 1: shear lives on cells; the far borders have none.
-    if (!has_right || !has_up) {
-      Ns12 = 0.0;
-      M12 = 0.0;
-    }
-    // §2.3 rule 2: a free edge carries no bending moment about itself.
-    if (!has_left || !has_right) M11 = 0.0;
-    if (!has_down || !has_up) M22 = 0.0;
-  }
+  Resultants s = constitutive(rest_, membrane_strain(g.lower, rest_.metric), bending_strain(b));
+  if (symmetric_borders_ && !p.interior()) symmetric_border_rules(p, s);
+  const double N11s = s.N_star[0], N12s = s.N_star[1], N22s = s.N_star[2];
+  const double M11 = s.M[0], M12 = s.M[1], M22 = s.M[2];
 
   NodeResultants& out = resultants_(k, l);
-  out.a1 = a1;
-  out.a2 = a2;
+  out.a1 = a.a1;
+  out.a2 = a.a2;
   out.normal = n;
-  // N^{ab} = N*^{ab} − Σ_λ b^a_λ M^{bλ} (§1).
-  out.N11 = Ns11 - (w11 * M11 + w12 * M12);
-  out.N12 = Ns12 - (w11 * M12 + w12 * M22);
-  out.N21 = Ns12 - (w21 * M11 + w22 * M12);
-  out.N22 = Ns22 - (w21 * M12 + w22 * M22);
+  // N^{αβ} = N*^{αβ} − Σ_λ b^α_λ M^{βλ} (§1).
+  out.N11 = N11s - (w.w11 * M11 + w.w12 * M12);
+  out.N12 = N12s - (w.w11 * M12 + w.w12 * M22);
+  out.N21 = N12s - (w.w21 * M11 + w.w22 * M12);
+  out.N22 = N22s - (w.w21 * M12 + w.w22 * M22);
   out.M11 = M11;
   out.M12 = M12;
   out.M22 = M22;
-  // Σ_b Σ_ρ (Γ^a_bρ M^{ρb} + Γ^b_bρ M^{aρ}) of N^{3a} (§1); §2.3 rule 3 keeps it off the
-  // borders, where the substituted second derivatives make Γ meaningless.
-  if (symmetric_borders_ && on_border) {
-    out.shear_christoffel1 = 0.0;
-    out.shear_christoffel2 = 0.0;
-  } else {
-    out.shear_christoffel1 =
-        G1_11 * M11 + 2.0 * G1_12 * M12 + G1_22 * M22 + trace1 * M11 + trace2 * M12;
-    out.shear_christoffel2 =
-        G2_11 * M11 + 2.0 * G2_12 * M12 + G2_22 * M22 + trace1 * M12 + trace2 * M22;
-  }
-  out.christoffel_trace1 = trace1;
-  out.christoffel_trace2 = trace2;
+  // §2.3 rule 3 keeps Γ·M off the borders, where the substituted second derivatives make Γ
+  // meaningless.
+  const bool drop_christoffel = symmetric_borders_ && !p.interior();
+  out.shear_christoffel1 = drop_christoffel ? 0.0 : shear_christoffel1(G, s.M);
+  out.shear_christoffel2 = drop_christoffel ? 0.0 : shear_christoffel2(G, s.M);
+  out.christoffel_trace1 = G.trace1();
+  out.christoffel_trace2 = G.trace2();
 }
 
 // D⁻ of the twisting moment M^{12} on the near border (B1 or B2), where the cell before p is
@@ -204,7 +180,8 @@ Vec3 CosseratModel::traction2(int k, int l) const {
   return p.N12 * p.a1 + p.N22 * p.a2 + N32 * p.normal;
 }
 
-void CosseratModel::internal_force(const Field<Vec3>& r, Field<Vec3>& force) {
+void CosseratModel::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
+                                   Field<Vec3>* normals) {
   const Block& b = *block_;
   // Resultants on the owned range grown by one node (clipped to the grid), tractions where
   // the divergence reads them: T^1 also at k0 − 1, T^2 also at l0 − 1.
@@ -238,6 +215,7 @@ void CosseratModel::internal_force(const Field<Vec3>& r, Field<Vec3>& force) {
         if (l < b.n - 1) f += inv_h2 * T2;
         if (l > 0) f -= inv_h2 * traction2_(k, l - 1);
         force(k, l) = f;
+        if (normals != nullptr) (*normals)(k, l) = p.normal;
       }
     }
   }

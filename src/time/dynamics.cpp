@@ -1,5 +1,6 @@
 #include "cosserat/time/dynamics.hpp"
 
+#include <cassert>
 #include <cmath>
 
 namespace cosserat {
@@ -30,9 +31,11 @@ double Dynamics::total_area(const Field<Vec3>& r) const {
   return block_area(r, area_quantum_).global_total(block_->comm);
 }
 
-VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a) {
+VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a,
+                                          Field<Vec3>* normals) {
   const Block& b = *block_;
-  model_.internal_force(r, a);
+  assert((normals != nullptr) == has_fluid());
+  model_.internal_force(r, a, normals);
   // S/M = 1/μ; the internal force carries f = S0/S, so its acceleration is f̂ S0/M (§3).
   const double inverse_density = needs_area_ ? total_area(r) / mass_ : 0.0;
   const double internal_scale = rest_area_ / mass_;
@@ -46,7 +49,7 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
     for (int k = b.k0; k < b.k1; ++k) {
       Vec3 acc = internal_scale * a(k, l) + g;
       if (fluid) {
-        const Vec3 n = model_.normal(k, l);
+        const Vec3 n = (*normals)(k, l);
         acc += (fluid_coefficient * dot(n, fluid_velocity)) * n;
       }
       a(k, l) = acc;
@@ -68,8 +71,8 @@ void Dynamics::internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a) {
 }
 
 void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step,
-                            Field<Vec3>& a) {
-  const VelocityTerms terms = free_acceleration(r, step, a);
+                            Field<Vec3>& a, Field<Vec3>* normals) {
+  const VelocityTerms terms = free_acceleration(r, step, a, normals);
   if (!has_velocity_terms()) return;
   const Block& b = *block_;
   const bool fluid = fluid_.has_value();
@@ -79,7 +82,7 @@ void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long ste
       const Vec3 vel = v(k, l);
       Vec3 acc = a(k, l) - terms.damping * vel;
       if (fluid) {
-        const Vec3 n = model_.normal(k, l);
+        const Vec3 n = (*normals)(k, l);
         acc -= (terms.fluid * dot(n, vel)) * n;
       }
       a(k, l) = acc;

@@ -27,23 +27,25 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
   return v;
 }
 
-Simulation::Simulation(const Scene& scene, MPI_Comm comm)
-    : Simulation(scene, comm, Decomposition::choose(scene.m, scene.n, size_of(comm))) {}
+Simulation::Simulation(const Scene& scene, MPI_Comm comm, const SchemeFactory& make)
+    : Simulation(scene, comm, Decomposition::choose(scene.m, scene.n, size_of(comm)), make) {}
 
-Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& decomposition)
+Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& decomposition,
+                       const SchemeFactory& make)
     : scene_(&scene),
       decomposition_(decomposition),
       block_(decomposition_.block(rank_in(comm), comm)),
       halo_(decomposition_, block_, rank_in(comm)),
       dynamics_(scene, block_, rest_positions(scene, block_)),
       stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),
-               initial_velocities(scene, block_)) {}
+               initial_velocities(scene, block_), make) {}
 
 double Simulation::memory_bytes(const Block& block, Integrator integrator) {
   const double ghosted_nodes = static_cast<double>(block.local_size());
   const double owned_nodes = static_cast<double>(block.owned_k()) * block.owned_l();
-  // rk4 keeps eight position-sized fields (state, new state, acceleration, four stages).
-  const double per_node = sizeof(NodeResultants) + 2 * sizeof(Vec3) + 8 * sizeof(Vec3);
+  // rk4 keeps nine position-sized fields (state and new state of r and v, acceleration, two
+  // stages, two weighted sums), and a fluid one more for the normals.
+  const double per_node = sizeof(NodeResultants) + 2 * sizeof(Vec3) + 10 * sizeof(Vec3);
   const double output_buffer = 3.0 * sizeof(double) * owned_nodes;
   // 3 rows of 75 entries per node, the colouring's index of every entry, PETSc's vectors:
   // measured 13 KB per node (peak RSS 578 MB against Verlet's 59 MB on 200 x 200).

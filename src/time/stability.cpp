@@ -9,12 +9,13 @@
 
 namespace cosserat {
 
-StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm) {
+StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm,
+                         const SchemeFactory& make) {
   Scene trial_scene = scene;
   trial_scene.dt = dt;
   trial_scene.steps = static_cast<long>(std::ceil(duration / dt - 1e-9));
   const auto start = std::chrono::steady_clock::now();
-  Simulation simulation(trial_scene, comm);
+  Simulation simulation(trial_scene, comm, make);
   StabilityTrial trial;
   trial.dt = dt;
   trial.stable = true;
@@ -36,10 +37,11 @@ StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Com
 }
 
 StableStep largest_stable_step(const Scene& scene, double duration, double tolerance, MPI_Comm comm,
+                               const SchemeFactory& make,
                                const std::function<void(const StabilityTrial&)>& report) {
   StableStep result;
   auto trial = [&](double dt) {
-    result.trials.push_back(run_trial(scene, dt, duration, comm));
+    result.trials.push_back(run_trial(scene, dt, duration, comm, make));
     if (report) report(result.trials.back());
     return result.trials.back().stable;
   };

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
 #include "mpi_support.hpp"
@@ -55,7 +56,7 @@ class Restart : public SharedFolder {
   // Runs `scene` on all ranks, split as the driver splits it, to half its steps and writes the
   // checkpoint.
   void checkpoint_at_half(const Scene& scene) const {
-    Simulation first(scene, MPI_COMM_WORLD);
+    Simulation first(scene, MPI_COMM_WORLD, any_scheme);
     ASSERT_TRUE(testing::advance(first, scene.steps / 2));
     write_checkpoint(checkpoint(), first, scene, "test");
   }
@@ -72,11 +73,11 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
   for (const Integrator integrator : explicit_integrators()) {
     const Scene scene = testing::odd_grid_scene(integrator);  // 80 steps
     const auto splits = all_splits(scene.m, scene.n, world_size());
-    Simulation uninterrupted(scene, MPI_COMM_SELF);  // one block: the comparisons' reference
+    Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);  // one block: the comparisons' reference
     ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
 
     checkpoint_at_half(scene);
-    Simulation other_split(scene, MPI_COMM_WORLD, splits.back());
+    Simulation other_split(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
     continue_to_end(other_split, scene);
     EXPECT_EQ(differing_nodes(other_split.positions(), uninterrupted.positions()), 0)
         << integrator_name(integrator) << ", split " << testing::split_name(splits.back());
@@ -84,7 +85,7 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
         << integrator_name(integrator);
 
     // Every rank restarts the whole grid alone from the file the P ranks wrote.
-    Simulation one_rank(scene, MPI_COMM_SELF);
+    Simulation one_rank(scene, MPI_COMM_SELF, any_scheme);
     continue_to_end(one_rank, scene);
     EXPECT_EQ(differing_nodes(one_rank.positions(), uninterrupted.positions()), 0)
         << integrator_name(integrator) << " restarted on one rank";
@@ -102,16 +103,16 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
 TEST_F(Restart, SemiImplicitContinuesOnAnotherSplitAndOnOneRank) {
   const Scene scene = testing::semi_implicit_odd_grid_scene();
   const auto splits = all_splits(scene.m, scene.n, world_size());
-  Simulation uninterrupted(scene, MPI_COMM_SELF);
+  Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
   checkpoint_at_half(scene);
-  Simulation other_split(scene, MPI_COMM_WORLD, splits.back());
+  Simulation other_split(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
   continue_to_end(other_split, scene);
   // As in test_semi_implicit.cpp: 40 solves to 1e-12 of |δ| stay far below 1e-9 m.
   EXPECT_LT(testing::largest_difference(other_split.positions(), uninterrupted.positions()), 1e-9)
       << "split " << testing::split_name(splits.back());
 
-  Simulation one_rank(scene, MPI_COMM_SELF);
+  Simulation one_rank(scene, MPI_COMM_SELF, any_scheme);
   continue_to_end(one_rank, scene);
   EXPECT_LT(testing::largest_difference(one_rank.positions(), uninterrupted.positions()), 1e-9)
       << "restarted on one rank";
@@ -122,18 +123,18 @@ TEST_F(Restart, RefusesACheckpointOfAnotherGridOrStep) {
   const std::string checkpoint = (folder_ / "run.checkpoint.h5").string();
   const Scene scene = testing::odd_grid_scene(Integrator::verlet);
   {
-    Simulation sim(scene, MPI_COMM_WORLD);
+    Simulation sim(scene, MPI_COMM_WORLD, any_scheme);
     ASSERT_TRUE(testing::advance(sim, 5));
     write_checkpoint(checkpoint, sim, scene, "test");
   }
   EXPECT_FALSE(fs::exists(checkpoint + ".partial"));
   Scene other_dt = scene;
   other_dt.dt *= 0.5;
-  Simulation sim(other_dt, MPI_COMM_WORLD);
+  Simulation sim(other_dt, MPI_COMM_WORLD, any_scheme);
   EXPECT_THROW(read_checkpoint(checkpoint, sim, other_dt), CheckpointError);
   Scene other_scheme = scene;
   other_scheme.integrator = Integrator::rk4;
-  Simulation rk4(other_scheme, MPI_COMM_WORLD);
+  Simulation rk4(other_scheme, MPI_COMM_WORLD, any_scheme);
   EXPECT_THROW(read_checkpoint(checkpoint, rk4, other_scheme), CheckpointError);
   EXPECT_THROW(read_checkpoint((folder_ / "missing.h5").string(), sim, other_dt), CheckpointError);
 }
@@ -145,7 +146,7 @@ TEST_F(Output, OfPRanksReadsBackEqualToOneRank) {
   const std::string parallel = (folder_ / "parallel.h5").string();
   const std::string serial = (folder_ / "serial.h5").string();
   auto run = [&](const std::string& path, MPI_Comm comm) {
-    Simulation sim(scene, comm);
+    Simulation sim(scene, comm, any_scheme);
     FrameWriter writer(path, sim.block(), scene.text, "verlet", "test", {});
     writer.write_frame(sim.step_index(), sim.time(), sim.positions());
     for (int frame = 0; frame < 4; ++frame) {

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <memory>
 
+#include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/halo.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "mpi_support.hpp"
@@ -99,10 +100,10 @@ TEST(DecompositionInvariance, WithoutTheHaloTheBorderForcesDiffer) {
 TEST(DecompositionInvariance, EveryIntegratorFollowsTheOneBlockTrajectory) {
   for (const Integrator integrator : explicit_integrators()) {
     const Scene scene = testing::odd_grid_scene(integrator);
-    Simulation reference(scene, MPI_COMM_SELF);
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
     ASSERT_TRUE(testing::advance(reference, scene.steps));
     for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
-      Simulation sim(scene, MPI_COMM_WORLD, d);
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
       const bool stable = testing::advance(sim, scene.steps);
       ASSERT_TRUE(stable);
       EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
@@ -117,13 +118,13 @@ TEST(DecompositionInvariance, EveryIntegratorFollowsTheOneBlockTrajectory) {
 // reference's count (OMP_NUM_THREADS).
 TEST(DecompositionInvariance, S2CapeFollowsTheOneBlockTrajectory) {
   const Scene scene = s2_cape(300);
-  Simulation reference(scene, MPI_COMM_SELF);
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(reference, scene.steps));
   const int default_threads = omp_get_max_threads();
   for (const int threads : {1, 3})
     for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
       omp_set_num_threads(threads);
-      Simulation sim(scene, MPI_COMM_WORLD, d);
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
       const bool stable = testing::advance(sim, scene.steps);
       omp_set_num_threads(default_threads);
       ASSERT_TRUE(stable);

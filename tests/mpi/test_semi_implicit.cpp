@@ -7,6 +7,7 @@
 
 #include <cstdio>
 
+#include "cosserat/baseline/semi_implicit.hpp"
 #include "mpi/mpi_support.hpp"
 #include "support/sheets.hpp"
 
@@ -20,13 +21,13 @@ namespace {
 // Jacobian carries the step.
 TEST(SemiImplicitDecomposition, EverySplitFollowsTheOneBlockTrajectory) {
   const Scene scene = testing::semi_implicit_odd_grid_scene();
-  Simulation reference(scene, MPI_COMM_SELF);
-  const Simulation start(scene, MPI_COMM_SELF);
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+  const Simulation start(scene, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(reference, scene.steps));
   // The comparison means something only if the sheet moved.
   EXPECT_GT(testing::largest_difference(reference.positions(), start.positions()), 1e-2);
   for (const Decomposition& d : testing::all_splits(scene.m, scene.n, testing::world_size())) {
-    Simulation sim(scene, MPI_COMM_WORLD, d);
+    Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
     ASSERT_TRUE(testing::advance(sim, scene.steps));
     const double difference = testing::largest_difference(sim.positions(), reference.positions());
     if (testing::world_rank() == 0)

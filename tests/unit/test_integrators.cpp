@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cosserat/baseline/semi_implicit.hpp"
 #include "support/sheets.hpp"
 
 namespace cosserat {
@@ -23,7 +24,7 @@ TEST_P(EveryScheme, FreeFall) {
   scene.gravity = {0.3, -9.8, 0.1};
   scene.initial_velocity = {1.0, 2.0, -0.5};
   scene.dt = 1e-3;
-  Simulation sim(scene, MPI_COMM_SELF);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
   const long steps = 500;
   ASSERT_TRUE(testing::advance(sim, steps));
   const double t = sim.time();
@@ -55,7 +56,7 @@ std::vector<Vec3> smooth_run(Integrator scheme, double dt) {
   scene.fluid = Fluid{0.032, {0.0, 0.0, 5.0}};
   scene.fixes.push_back(testing::fix_nodes({{0, 0}}));
   scene.dt = dt;
-  Simulation sim(scene, MPI_COMM_SELF);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
   const long steps = std::lround(0.2 / dt);
   EXPECT_TRUE(testing::advance(sim, steps));
   std::vector<Vec3> out;

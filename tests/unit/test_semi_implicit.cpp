@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/model/wave_speed.hpp"
 #include "support/sheets.hpp"
 
@@ -47,7 +48,7 @@ TEST(SemiImplicit, WithoutStiffnessItIsVerlet) {
   verlet.material.phi = {0.0, 0.0, 0.0};
   Scene implicit = verlet;
   implicit.integrator = Integrator::semi_implicit;
-  Simulation a(verlet, MPI_COMM_SELF), b(implicit, MPI_COMM_SELF);
+  Simulation a(verlet, MPI_COMM_SELF, any_scheme), b(implicit, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(a, 60));
   ASSERT_TRUE(testing::advance(b, 60));
   double worst = 0.0, moved = 0.0;
@@ -67,7 +68,7 @@ TEST(SemiImplicit, WithoutStiffnessItIsVerlet) {
 TEST(SemiImplicit, HeldComponentsStay) {
   Scene scene = busy_sheet(Integrator::semi_implicit);
   scene.fixes.back().axes = {false, true, false};
-  Simulation sim(scene, MPI_COMM_SELF);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(sim, 5));
   const Vec3 pinned = sim.positions()(0, 0);
   const double y_held = sim.positions()(8, 6).y;
@@ -89,10 +90,10 @@ TEST(SemiImplicit, StableBeyondTheExplicitLimit) {
   scene.dt = 3.0 * cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2()).dt;
   const long steps = std::lround(3.0 / scene.dt);
   scene.integrator = Integrator::verlet;
-  Simulation verlet(scene, MPI_COMM_SELF);
+  Simulation verlet(scene, MPI_COMM_SELF, any_scheme);
   EXPECT_FALSE(testing::advance(verlet, steps));
   scene.integrator = Integrator::semi_implicit;
-  Simulation implicit(scene, MPI_COMM_SELF);
+  Simulation implicit(scene, MPI_COMM_SELF, any_scheme);
   EXPECT_TRUE(testing::advance(implicit, steps));
   const Diagnostics d = implicit.diagnostics();
   EXPECT_NEAR(d.area_ratio, 1.0, 0.1);
@@ -101,7 +102,7 @@ TEST(SemiImplicit, StableBeyondTheExplicitLimit) {
 // The run summary's numbers: one solve per step, at least one iteration each.
 TEST(SemiImplicit, CountsItsSolves) {
   Scene scene = busy_sheet(Integrator::semi_implicit);
-  Simulation sim(scene, MPI_COMM_SELF);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(sim, 12));
   const auto solves = sim.stepper().linear_solves();
   ASSERT_TRUE(solves.has_value());
@@ -109,7 +110,7 @@ TEST(SemiImplicit, CountsItsSolves) {
   EXPECT_GE(solves->iterations, 12);
   EXPECT_GE(solves->most_iterations, 1);
   scene.integrator = Integrator::verlet;
-  Simulation explicit_run(scene, MPI_COMM_SELF);
+  Simulation explicit_run(scene, MPI_COMM_SELF, any_scheme);
   EXPECT_FALSE(explicit_run.stepper().linear_solves().has_value());
 }
 
@@ -117,10 +118,10 @@ TEST(SemiImplicit, CountsItsSolves) {
 TEST(SemiImplicit, UnknownKrylovMethodIsASceneError) {
   Scene scene = busy_sheet(Integrator::semi_implicit);
   scene.solver.ksp = "no-such-method";
-  EXPECT_THROW(Simulation(scene, MPI_COMM_SELF), SceneError);
+  EXPECT_THROW(Simulation(scene, MPI_COMM_SELF, any_scheme), SceneError);
   scene.solver.ksp = "gmres";
   scene.solver.pc = "no-such-preconditioner";
-  EXPECT_THROW(Simulation(scene, MPI_COMM_SELF), SceneError);
+  EXPECT_THROW(Simulation(scene, MPI_COMM_SELF, any_scheme), SceneError);
 }
 
 #else

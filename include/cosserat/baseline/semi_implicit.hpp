@@ -8,54 +8,20 @@
 // D = ϱ_D/μ and F = ϱ_R/μ the velocity terms taken at the step's centre, as the
 // explicit Verlet does (MODEL.md §4). J comes from the explicit schemes' own
 // force kernel by coloured finite differences on a DMDA laid over the same
-// decomposition; held components are eliminated; KSP solves. Built only with
-// PETSc: without it the scene loader refuses the integrator and these functions
-// are never reached.
+// decomposition; held components are eliminated; KSP solves. Without PETSc the
+// scene loader refuses the integrator, and any_scheme builds the explicit ones.
 
 #include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
-#include "cosserat/time/linear_solve_stats.hpp"
-#include "cosserat/grid/block.hpp"
-#include "cosserat/grid/decomposition.hpp"
-#include "cosserat/scene/scene.hpp"
-#include "cosserat/time/constraints.hpp"
-#include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/scheme.hpp"
 
 namespace cosserat {
 
-class SemiImplicitSolver {
- public:
-  // Sets up the DMDA, Jacobian colouring and KSP from scene.solver, then
-  // PETSc's options database (-ksp_*, -pc_*, ...). Starts PETSc on first use.
-  // Throws SceneError for a KSP or PC name PETSc does not know.
-  SemiImplicitSolver(const Scene& scene, const Decomposition& decomposition, const Block& block,
-                     Dynamics& dynamics);
-  ~SemiImplicitSolver();
-  SemiImplicitSolver(const SemiImplicitSolver&) = delete;
-  SemiImplicitSolver& operator=(const SemiImplicitSolver&) = delete;
-
-  // J at r (owned nodes; the DMDA fills its own ghosts). Evaluates the internal
-  // force about 76 times, so Dynamics::normal() is stale afterwards.
-  void linearise(const Field<Vec3>& r);
-
-  // Solves the system for δ with the J of the last linearise(), velocity terms
-  // `terms` (normals from dynamics.normal()), right-hand side `rhs`, starting
-  // from `guess`. The components `held` lists get δ = 0. Returns why the solve
-  // failed, or nothing.
-  std::optional<std::string> solve(const VelocityTerms& terms, const Field<Vec3>& rhs,
-                                   const Field<Vec3>& guess,
-                                   const std::vector<Constraints::NodeState>& held,
-                                   Field<Vec3>& delta);
-
-  const LinearSolveStats& stats() const;
-
- private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
-};
+// The scheme a scene asks for: the semi-implicit baseline for "semi-implicit", the time
+// module's explicit schemes for the others. Whoever assembles a Simulation passes this to run
+// every scheme this build has.
+std::unique_ptr<Scheme> any_scheme(const SchemeSetup& setup);
 
 // Adds PETSc options (e.g. "-ksp_type cg -pc_type jacobi") for solvers made
 // later, starting PETSc if needed. PETSC_OPTIONS in the environment is read

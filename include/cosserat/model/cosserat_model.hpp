@@ -39,11 +39,10 @@ class CosseratModel {
   // Internal force per unit current area at every owned node, for the area factor f = 1:
   // the physical force is (S0/S) times this (MODEL.md §1), so the internal acceleration is
   // this times S0/M whatever the current area. Reads positions up to two nodes outside the
-  // owned range (ghosts must be current).
-  void internal_force(const Field<Vec3>& positions, Field<Vec3>& force);
-
-  // Unit normals of the owned nodes from the last internal_force call.
-  Vec3 normal(int k, int l) const { return resultants_(k, l).normal; }
+  // owned range (ghosts must be current). With `normals`, also the unit normal n of every
+  // owned node at these positions, which the fluid term needs (§1).
+  void internal_force(const Field<Vec3>& positions, Field<Vec3>& force,
+                      Field<Vec3>* normals = nullptr);
 
  private:
   void compute_resultants(const Field<Vec3>& r, int k, int l);

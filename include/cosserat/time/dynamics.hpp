@@ -23,20 +23,21 @@ class Dynamics {
   Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions);
 
   // The velocity-free part of the acceleration at `step` into `a`, and the coefficients of
-  // the velocity terms, for schemes that treat those at the step's centre.
-  VelocityTerms free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a);
+  // the velocity terms, for schemes that treat those at the step's centre. `normals` receives
+  // the unit normals at r that the fluid terms use: required when has_fluid(), else null.
+  VelocityTerms free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a,
+                                  Field<Vec3>* normals);
 
   // The internal force's share of the acceleration, f_int/μ, into `a`: independent of S
   // (MODEL.md §3), so a function of the positions alone. The semi-implicit baseline
-  // differentiates it. Overwrites the normals that normal() reports.
+  // differentiates it.
   void internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a);
 
-  // The whole acceleration A(r, v) at `step`.
-  void acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step, Field<Vec3>& a);
+  // The whole acceleration A(r, v) at `step`; `normals` as for free_acceleration.
+  void acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step, Field<Vec3>& a,
+                    Field<Vec3>* normals);
 
-  // Unit normal of an owned node at the last evaluated positions (fluid term).
-  Vec3 normal(int k, int l) const { return model_.normal(k, l); }
-
+  bool has_fluid() const { return fluid_.has_value(); }
   bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
   double rest_area() const { return rest_area_; }
   // S, a global reduction, the same bitwise for any decomposition; reads the ghosts of r.

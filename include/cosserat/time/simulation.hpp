@@ -27,9 +27,12 @@ struct Diagnostics {
 class Simulation {
  public:
   // The scene on the ranks of comm, split by Decomposition::choose (throws
-  // DecompositionError when the grid is too small for that many ranks) or as given.
-  Simulation(const Scene& scene, MPI_Comm comm);
-  Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& decomposition);
+  // DecompositionError when the grid is too small for that many ranks) or as given, its
+  // scheme built by `make`: this module's explicit schemes, or the baseline module's
+  // any_scheme, which adds the semi-implicit one.
+  Simulation(const Scene& scene, MPI_Comm comm, const SchemeFactory& make = explicit_scheme);
+  Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& decomposition,
+             const SchemeFactory& make = explicit_scheme);
   Simulation(const Simulation&) = delete;
   Simulation& operator=(const Simulation&) = delete;
 

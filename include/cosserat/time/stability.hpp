@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cosserat/scene/scene.hpp"
+#include "cosserat/time/scheme.hpp"
 
 namespace cosserat {
 
@@ -22,7 +23,9 @@ struct StabilityTrial {
   double wall_seconds = 0.0;
 };
 
-StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm);
+// The scheme is built by `make`, as for Simulation.
+StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm,
+                         const SchemeFactory& make);
 
 struct StableStep {
   double stable_dt = 0.0;    // the largest step found stable (0: none, down to the floor)
@@ -36,6 +39,7 @@ struct StableStep {
 // of the scene's dt end the search unbracketed. `report` sees every trial as it
 // ends (rank 0 prints progress with it).
 StableStep largest_stable_step(const Scene& scene, double duration, double tolerance, MPI_Comm comm,
+                               const SchemeFactory& make,
                                const std::function<void(const StabilityTrial&)>& report = {});
 
 }  // namespace cosserat

@@ -1,19 +1,19 @@
 #pragma once
-// The explicit time integrators of MODEL.md §4, each applying the constraints of §4.1 after
-// every stage, and the stability monitor of §4.2.
+// The step of MODEL.md §4 for any scheme: the constraint windows of §4.1, the per-step actions,
+// the stability monitor of §4.2 and the step count around one Scheme.
 
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/halo.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
 #include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/scheme.hpp"
 
 namespace cosserat {
 
@@ -27,71 +27,71 @@ struct Instability {
   std::optional<std::string> solver_failure;
 };
 
+// The state a step proposes, before the stability check accepts it.
+struct ProposedStep {
+  long step;  // the step it ends at
+  double dt;
+  const Field<Vec3>& positions;  // at the step's start
+  Field<Vec3>& next_positions;
+  Field<Vec3>* next_velocities;  // null for schemes that carry r⁻ instead (see Scheme)
+};
+
+// Something done on every step whatever the scheme (a contact response, a step-size choice):
+// the one place such an action hooks in. It sees the proposed state after the scheme and its
+// constraints, before the stability check.
+class StepAction {
+ public:
+  virtual ~StepAction() = default;
+  virtual void apply(ProposedStep& proposed) = 0;
+};
+
 class Stepper {
  public:
-  // Takes the state at step 0: positions, velocities. Exchanges the ghosts of every position
-  // field before the forces read it. The decomposition is the one `block` and `halo` come
-  // from; the semi-implicit baseline lays its PETSc grid over it.
+  // Takes the state at step 0: positions, velocities. Builds the scheme with `make` (the
+  // explicit schemes of this module, or the baseline's any_scheme); the decomposition is the
+  // one `block` and `halo` come from.
   Stepper(const Scene& scene, const Decomposition& decomposition, const Block& block, Halo& halo,
-          Dynamics& dynamics, const Field<Vec3>& positions, const Field<Vec3>& velocities);
+          Dynamics& dynamics, const Field<Vec3>& positions, Field<Vec3> velocities,
+          const SchemeFactory& make);
+  Stepper(const Stepper&) = delete;
+  Stepper& operator=(const Stepper&) = delete;
 
   // Advances one step. On instability the state is left at the last good step and the
   // failure is returned.
   std::optional<Instability> step();
 
+  // Runs `action` on every later step, after those added before it.
+  void add_action(std::unique_ptr<StepAction> action) { actions_.push_back(std::move(action)); }
+
+  using StateField = Scheme::StateField;
   // The fields that carry the scheme's state from one step to the next: together with the
   // step index and the constraints' state, all a restart needs to continue bitwise.
-  struct StateField {
-    std::string name;
-    Field<Vec3>* field;
-  };
-  std::vector<StateField> state_fields();
+  std::vector<StateField> state_fields() { return scheme_->state_fields(); }
   Constraints& constraints() { return constraints_; }
   // Continues from `step` after the state fields and constraints were overwritten.
   void resume(long step);
 
   long step_index() const { return step_; }
   double time() const { return time_; }
-  const Field<Vec3>& positions() const { return r_; }
+  const Field<Vec3>& positions() const { return scheme_->positions(); }
   // The scheme's velocity at the current time; for the Verlet family, which carries none,
   // the backward difference (r − r⁻)/Δt, the velocity half a step back.
-  const Field<Vec3>& velocities();
+  const Field<Vec3>& velocities() { return scheme_->velocities(); }
 
   // The semi-implicit baseline's linear solves so far; nothing for the explicit schemes.
-  std::optional<LinearSolveStats> linear_solves() const;
+  std::optional<LinearSolveStats> linear_solves() const { return scheme_->linear_solves(); }
 
  private:
-  void start();
-  void verlet_step();
-  void verlet_lagged_step();
-  void leapfrog_step();
-  void euler_step(bool symplectic);
-  void midpoint_step();
-  void rk4_step();
-  void velocity_verlet_step();
-  std::optional<std::string> semi_implicit_step();
   std::optional<Instability> check(const Field<Vec3>& next) const;
-  void hold(Field<Vec3>& r, Field<Vec3>& v) const;
 
   const Block* block_;
-  Halo* halo_;
-  Dynamics* dynamics_;
   Constraints constraints_;
-  Integrator scheme_;
   double dt_;
-  double dt_previous_;  // Δt_{n−1} of tc-verlet; the scene's step is constant
-  double max_move_;     // half the smaller grid spacing (MODEL.md §4.2)
+  double max_move_;  // half the smaller grid spacing (MODEL.md §4.2)
   long step_ = 0;
   double time_ = 0.0;
-
-  Field<Vec3> r_, v_;   // current state (v: v^{n−½} for leapfrog)
-  Field<Vec3> r_next_;  // the new positions before acceptance
-  Field<Vec3> r_prev_;  // Verlet family: r⁻
-  Field<Vec3> a_;       // acceleration (velocity-verlet keeps it across steps)
-  Field<Vec3> r_stage_, v_stage_, r_sum_, v_sum_;  // Runge–Kutta stages
-  std::unique_ptr<SemiImplicitSolver> implicit_;
-  bool velocities_current_ = false;
-  Field<Vec3> v_report_;
+  std::unique_ptr<Scheme> scheme_;
+  std::vector<std::unique_ptr<StepAction>> actions_;
 };
 
 }  // namespace cosserat

@@ -1,0 +1,152 @@
+#pragma once
+// The time integrators of MODEL.md §4, one type per scheme family. Each owns the state it
+// carries from one step to the next under the name of what it holds; the Stepper around it
+// does what every scheme shares (constraint windows, per-step actions, the stability check,
+// the step count).
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/grid/decomposition.hpp"
+#include "cosserat/grid/halo.hpp"
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/constraints.hpp"
+#include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/linear_solve_stats.hpp"
+
+namespace cosserat {
+
+// Runs body(k, l) over the owned nodes, rows shared among threads.
+template <class Body>
+void for_owned(const Block& b, Body&& body) {
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) body(k, l);
+}
+
+// What every scheme works with: the block and its halo, the forces, the constraints it applies
+// after every stage (MODEL.md §4.1), and the step.
+struct StepContext {
+  const Block& block;
+  Halo& halo;
+  Dynamics& dynamics;
+  Constraints& constraints;
+  double dt;
+};
+
+class Scheme {
+ public:
+  // A field that carries the scheme's state from one step to the next (for checkpoints).
+  struct StateField {
+    std::string name;
+    Field<Vec3>* field;
+  };
+
+  Scheme(const StepContext& context, const Field<Vec3>& positions);
+  virtual ~Scheme() = default;
+  Scheme(const Scheme&) = delete;
+  Scheme& operator=(const Scheme&) = delete;
+
+  // Takes the velocities at step 0: holds the state at step 0 (the constraints of step 0
+  // switched on), exchanges the positions' ghosts and builds the history the first step needs.
+  void begin(Field<Vec3> velocities);
+
+  // Proposes the state at step + 1 into next_positions() (and next_velocities()), held by the
+  // constraints. Returns why a linear solve failed, or nothing.
+  virtual std::optional<std::string> advance(long step) = 0;
+
+  // The proposed state becomes the current one, its positions' ghosts exchanged.
+  void accept();
+
+  // After a restart overwrote the state fields.
+  void resume();
+
+  const Field<Vec3>& positions() const { return positions_; }
+  Field<Vec3>& next_positions() { return next_positions_; }
+  // The proposed velocities, for schemes that carry velocities; the others carry r⁻ instead,
+  // so changing next_positions() changes their velocity too.
+  virtual Field<Vec3>* next_velocities() { return nullptr; }
+
+  // The velocity at the current time (see Stepper::velocities).
+  virtual const Field<Vec3>& velocities() = 0;
+
+  // Together with the step index and the constraints' state, all a restart needs.
+  virtual std::vector<StateField> state_fields() = 0;
+
+  // The semi-implicit baseline's linear solves; nothing for the explicit schemes.
+  virtual std::optional<LinearSolveStats> linear_solves() const { return std::nullopt; }
+
+ protected:
+  // Builds the history the first step needs (MODEL.md §4) from the state at step 0, whose
+  // positions are held and exchanged and whose velocities are held.
+  virtual void start(Field<Vec3> velocities) = 0;
+  // The family's own fields take their new values; accept() then swaps the positions.
+  virtual void accept_state() = 0;
+  // Whether advance() already exchanged the new positions' ghosts (velocity-verlet reads
+  // forces there), so accept() need not.
+  virtual bool exchanged_next_positions() const { return false; }
+  // Called by resume(), for families that cache something derived from the state.
+  virtual void state_changed() {}
+
+  // Where the fluid term's normals go, or null when the scene has no fluid.
+  Field<Vec3>* normals() { return context_.dynamics.has_fluid() ? &normals_ : nullptr; }
+  void hold(Field<Vec3>& r, Field<Vec3>& v) const;
+
+  StepContext context_;
+  Field<Vec3> positions_;       // rⁿ
+  Field<Vec3> next_positions_;  // rⁿ⁺¹, proposed
+  Field<Vec3> acceleration_;    // of the last force evaluation
+  Field<Vec3> normals_;         // allocated only with a fluid
+};
+
+// The Verlet family (verlet, tc-verlet, verlet-lagged): state (rⁿ, rⁿ⁻¹), no velocity carried.
+// The semi-implicit baseline derives from it: its step is Verlet's with J added.
+class VerletFamily : public Scheme {
+ public:
+  VerletFamily(const StepContext& context, const Field<Vec3>& positions, Integrator scheme);
+
+  std::optional<std::string> advance(long step) final;
+  // The backward difference (r − r⁻)/Δt: the velocity half a step back.
+  const Field<Vec3>& velocities() override;
+  std::vector<StateField> state_fields() override;
+
+ protected:
+  void start(Field<Vec3> velocities) override;
+  // The new positions from (rⁿ, rⁿ⁻¹): verlet-lagged's or the centred step.
+  virtual std::optional<std::string> propose(long step);
+  void accept_state() override;
+  void state_changed() override { velocities_current_ = false; }
+
+  Field<Vec3> previous_positions_;  // rⁿ⁻¹
+  double dt_previous_;              // Δt_{n−1} of tc-verlet; the scene's step is constant
+
+ private:
+  void centred_step(long step);
+  void lagged_step(long step);
+
+  bool published_;             // verlet-lagged: first-order start, velocity terms lagged
+  Field<Vec3> lagged_velocity_;  // verlet-lagged: (rⁿ − rⁿ⁻¹)/Δt fed to the forces
+  Field<Vec3> velocity_report_;  // what velocities() returns
+  bool velocities_current_ = false;
+};
+
+// What a scheme is built from: the scene (the scheme and its settings), the decomposition the
+// block comes from (the semi-implicit baseline lays its PETSc grid over it), the context and
+// the positions at step 0.
+struct SchemeSetup {
+  const Scene& scene;
+  const Decomposition& decomposition;
+  const StepContext& context;
+  const Field<Vec3>& positions;
+};
+using SchemeFactory = std::function<std::unique_ptr<Scheme>(const SchemeSetup&)>;
+
+// The explicit schemes of this module. The semi-implicit one is the baseline module's
+// (baseline/semi_implicit.hpp: any_scheme): asked for it, this throws std::logic_error.
+std::unique_ptr<Scheme> explicit_scheme(const SchemeSetup& setup);
+
+}  // namespace cosserat

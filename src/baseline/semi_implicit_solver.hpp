@@ -1,0 +1,51 @@
+#pragma once
+// The linear system of the semi-implicit step on PETSc (see cosserat/baseline/semi_implicit.hpp
+// and docs/semi-implicit.md). Private to the baseline module, built only with PETSc.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+#include "cosserat/grid/decomposition.hpp"
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/constraints.hpp"
+#include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/linear_solve_stats.hpp"
+
+namespace cosserat {
+
+class SemiImplicitSolver {
+ public:
+  // Sets up the DMDA, Jacobian colouring and KSP from scene.solver, then
+  // PETSc's options database (-ksp_*, -pc_*, ...). Starts PETSc on first use.
+  // Throws SceneError for a KSP or PC name PETSc does not know.
+  SemiImplicitSolver(const Scene& scene, const Decomposition& decomposition, const Block& block,
+                     Dynamics& dynamics);
+  ~SemiImplicitSolver();
+  SemiImplicitSolver(const SemiImplicitSolver&) = delete;
+  SemiImplicitSolver& operator=(const SemiImplicitSolver&) = delete;
+
+  // J at r (owned nodes; the DMDA fills its own ghosts). Evaluates the internal
+  // force about 76 times.
+  void linearise(const Field<Vec3>& r);
+
+  // Solves the system for δ with the J of the last linearise(), velocity terms
+  // `terms` (and the normals at rⁿ when there is a fluid), right-hand side `rhs`, starting
+  // from `guess`. The components `held` lists get δ = 0. Returns why the solve
+  // failed, or nothing.
+  std::optional<std::string> solve(const VelocityTerms& terms, const Field<Vec3>* normals,
+                                   const Field<Vec3>& rhs,
+                                   const Field<Vec3>& guess,
+                                   const std::vector<Constraints::NodeState>& held,
+                                   Field<Vec3>& delta);
+
+  const LinearSolveStats& stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cosserat

@@ -1,0 +1,111 @@
+#include "cosserat/time/scheme.hpp"
+
+#include "explicit_schemes.hpp"
+
+namespace cosserat {
+
+VerletFamily::VerletFamily(const StepContext& context, const Field<Vec3>& positions,
+                           Integrator scheme)
+    : Scheme(context, positions),
+      previous_positions_(context.block),
+      dt_previous_(context.dt),
+      published_(scheme == Integrator::verlet_lagged),
+      velocity_report_(context.block) {}
+
+// The second-order start r⁻ = r − Δt v + ½Δt² a; verlet-lagged keeps the published first-order
+// one (MODEL.md §4).
+void VerletFamily::start(Field<Vec3> velocities) {
+  const double dt = context_.dt;
+  if (published_) {
+    for_owned(context_.block, [&](int k, int l) {
+      previous_positions_(k, l) = positions_(k, l) - dt * velocities(k, l);
+    });
+    lagged_velocity_ = std::move(velocities);
+  } else {
+    context_.dynamics.acceleration(positions_, velocities, 0, acceleration_, normals());
+    for_owned(context_.block, [&](int k, int l) {
+      previous_positions_(k, l) =
+          positions_(k, l) - dt * velocities(k, l) + (0.5 * dt * dt) * acceleration_(k, l);
+    });
+  }
+  context_.constraints.hold_positions(previous_positions_);
+}
+
+std::optional<std::string> VerletFamily::advance(long step) {
+  velocities_current_ = false;
+  return propose(step);
+}
+
+std::optional<std::string> VerletFamily::propose(long step) {
+  if (published_)
+    lagged_step(step);
+  else
+    centred_step(step);
+  return std::nullopt;
+}
+
+// verlet and tc-verlet: r⁺ = r + (r − r⁻) Δtₙ/Δtₙ₋₁ + Δtₙ² a with the velocity terms at the
+// centre, v = (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁), solved in closed form (MODEL.md §4). With a constant
+// step both are the plain central-difference Verlet.
+void VerletFamily::centred_step(long step) {
+  context_.constraints.hold_positions(previous_positions_);  // a node held from now on starts at rest
+  Field<Vec3>* n_field = normals();
+  const VelocityTerms terms =
+      context_.dynamics.free_acceleration(positions_, step, acceleration_, n_field);
+  const double dt = context_.dt;
+  const double dt2 = dt * dt;
+  const double ratio = dt / dt_previous_;
+  const double span = dt + dt_previous_;
+  const double c = terms.damping * dt2 / span;
+  const double d = terms.fluid * dt2 / span;
+  for_owned(context_.block, [&](int k, int l) {
+    const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
+    Vec3 rhs = r + ratio * (r - rp) + dt2 * acceleration_(k, l) + c * rp;
+    if (d > 0.0) {
+      const Vec3 n = (*n_field)(k, l);
+      rhs += (d * dot(n, rp)) * n;
+      next_positions_(k, l) = solve_centred(rhs, n, c, d);
+    } else {
+      next_positions_(k, l) = rhs / (1.0 + c);
+    }
+  });
+  context_.constraints.hold_positions(next_positions_);
+}
+
+// The published Verlet: velocity terms lagged, v = (r − r⁻)/Δt; first order (MODEL.md §4).
+void VerletFamily::lagged_step(long step) {
+  context_.constraints.hold_positions(previous_positions_);
+  const double dt = context_.dt;
+  for_owned(context_.block, [&](int k, int l) {
+    lagged_velocity_(k, l) = (positions_(k, l) - previous_positions_(k, l)) / dt;
+  });
+  context_.dynamics.acceleration(positions_, lagged_velocity_, step, acceleration_, normals());
+  for_owned(context_.block, [&](int k, int l) {
+    next_positions_(k, l) =
+        2.0 * positions_(k, l) - previous_positions_(k, l) + (dt * dt) * acceleration_(k, l);
+  });
+  context_.constraints.hold_positions(next_positions_);
+}
+
+void VerletFamily::accept_state() {
+  // rⁿ becomes rⁿ⁻¹; Scheme::accept then makes the proposed positions rⁿ.
+  previous_positions_.swap(positions_);
+  dt_previous_ = context_.dt;
+}
+
+const Field<Vec3>& VerletFamily::velocities() {
+  if (!velocities_current_) {
+    const double dt = dt_previous_;
+    for_owned(context_.block, [&](int k, int l) {
+      velocity_report_(k, l) = (positions_(k, l) - previous_positions_(k, l)) / dt;
+    });
+    velocities_current_ = true;
+  }
+  return velocity_report_;
+}
+
+std::vector<Scheme::StateField> VerletFamily::state_fields() {
+  return {{"positions", &positions_}, {"previous_positions", &previous_positions_}};
+}
+
+}  // namespace cosserat
