@@ -16,12 +16,15 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <initializer_list>
 #include <sstream>
 #include <string_view>
 
+#include "checked_toml.hpp"
+
 namespace cosserat {
 namespace {
+
+using namespace scene_detail;
 
 // Source name of values parsed from --set arguments.
 constexpr std::string_view kSetSource = "--set";
@@ -35,223 +38,6 @@ std::string_view trim(std::string_view text) {
 
 std::string joined(const std::vector<std::string>& words) {
   return fmt::format("{}", fmt::join(words, ", "));
-}
-
-// What a user wrote, for "got ..." in messages.
-std::string describe(const toml::node& node) {
-  if (const auto* text = node.as_string()) return fmt::format("the string \"{}\"", text->get());
-  if (const auto* integer = node.as_integer()) return fmt::format("the integer {}", integer->get());
-  if (const auto* real = node.as_floating_point()) return fmt::format("the number {}", real->get());
-  if (const auto* boolean = node.as_boolean()) return fmt::format("the boolean {}", boolean->get());
-  if (const auto* array = node.as_array()) {
-    return fmt::format("an array of {} entries", array->size());
-  }
-  if (node.is_table()) return "a table";
-  return "a date or time";
-}
-
-// The file messages point into. Values whose source is not that file came from --set.
-class Origin {
- public:
-  explicit Origin(std::string path) : path_(std::move(path)) {}
-
-  const std::string& path() const { return path_; }
-
-  // "file:line", "file (from --set)", or "file" when there is no node to point at.
-  std::string locate(const toml::node* node) const {
-    if (node == nullptr) return path_;
-    const auto& source = node->source();
-    if (!source.path || *source.path != path_) return path_ + " (from --set)";
-    return fmt::format("{}:{}", path_, source.begin.line);
-  }
-
-  [[noreturn]] void fail(const toml::node* node, std::string_view key,
-                         std::string_view what) const {
-    throw SceneError(fmt::format("{}: key '{}': {}", locate(node), key, what));
-  }
-
- private:
-  std::string path_;
-};
-
-class Table;
-
-// One value of the scene with its full dotted key; the typed readers reject anything else.
-class Entry {
- public:
-  Entry(const Origin& origin, const toml::node& node, std::string key)
-      : origin_(&origin), node_(&node), key_(std::move(key)) {}
-
-  [[noreturn]] void fail(std::string_view what) const { origin_->fail(node_, key_, what); }
-
-  // Integers are accepted where numbers are expected; inf and nan never are.
-  double number() const {
-    double value = 0.0;
-    if (const auto* integer = node_->as_integer()) {
-      value = static_cast<double>(integer->get());
-    } else if (const auto* real = node_->as_floating_point()) {
-      value = real->get();
-    } else {
-      fail(fmt::format("must be a number, got {}", describe(*node_)));
-    }
-    if (!std::isfinite(value)) fail(fmt::format("must be a finite number, got {}", value));
-    return value;
-  }
-
-  long integer() const {
-    const auto* integer = node_->as_integer();
-    if (integer == nullptr) fail(fmt::format("must be an integer, got {}", describe(*node_)));
-    return integer->get();
-  }
-
-  std::string string() const {
-    const auto* text = node_->as_string();
-    if (text == nullptr) fail(fmt::format("must be a string, got {}", describe(*node_)));
-    return text->get();
-  }
-
-  // The elements of an array of `size` entries (any size when 0); `what` names the expected form.
-  std::vector<Entry> elements(std::size_t size, std::string_view what) const {
-    const auto* array = node_->as_array();
-    if (array == nullptr || (size != 0 && array->size() != size)) {
-      fail(fmt::format("must be {}, got {}", what, describe(*node_)));
-    }
-    std::vector<Entry> entries;
-    for (std::size_t i = 0; i < array->size(); ++i) {
-      entries.emplace_back(*origin_, (*array)[i], fmt::format("{}[{}]", key_, i));
-    }
-    return entries;
-  }
-
-  Vec3 vector3() const {
-    const auto entries = elements(3, "an array of 3 numbers [x, y, z]");
-    return {entries[0].number(), entries[1].number(), entries[2].number()};
-  }
-
-  // A material tensor: one number (isotropic) or [t11, t12, t22].
-  Sym2 tensor() const {
-    if (node_->is_number()) {
-      const double value = number();
-      return {value, value, value};
-    }
-    if (!node_->is_array()) {
-      fail(fmt::format("must be a number or an array of 3 numbers [t11, t12, t22], got {}",
-                       describe(*node_)));
-    }
-    const auto entries = elements(3, "a number or an array of 3 numbers [t11, t12, t22]");
-    return {entries[0].number(), entries[1].number(), entries[2].number()};
-  }
-
-  Table table() const;
-  std::vector<Table> tables(std::string_view block) const;
-
- private:
-  const Origin* origin_;
-  const toml::node* node_;
-  std::string key_;
-};
-
-// One TOML table with its dotted key ("" for the top level).
-class Table {
- public:
-  Table(const Origin& origin, const toml::table& table, std::string key, bool top_level = false)
-      : origin_(&origin), table_(&table), key_(std::move(key)), top_level_(top_level) {}
-
-  std::string key_of(std::string_view name) const {
-    return key_.empty() ? std::string(name) : fmt::format("{}.{}", key_, name);
-  }
-
-  // Rejects the first key not in `allowed`: a typo must not silently become a default.
-  void allow(std::initializer_list<std::string_view> allowed) const {
-    for (auto&& [name, node] : *table_) {
-      if (std::find(allowed.begin(), allowed.end(), name.str()) == allowed.end()) {
-        Entry(*origin_, node, key_of(name.str()))
-            .fail(fmt::format("unknown key; allowed here: {}", fmt::join(allowed, ", ")));
-      }
-    }
-  }
-
-  std::optional<Entry> find(std::string_view name) const {
-    const auto* node = table_->get(name);
-    if (node == nullptr) return std::nullopt;
-    return Entry(*origin_, *node, key_of(name));
-  }
-
-  std::optional<Table> find_table(std::string_view name) const {
-    if (const auto entry = find(name)) return entry->table();
-    return std::nullopt;
-  }
-
-  // `what` says what the missing key should hold.
-  [[noreturn]] void missing(std::string_view name, std::string_view what) const {
-    origin_->fail(locator(), key_of(name), fmt::format("required: {}", what));
-  }
-
-  Entry require(std::string_view name, std::string_view what) const {
-    if (auto entry = find(name)) return *entry;
-    missing(name, what);
-  }
-
-  Table require_table(std::string_view name, std::string_view what) const {
-    if (auto table = find_table(name)) return *table;
-    missing(name, what);
-  }
-
-  [[noreturn]] void fail(std::string_view what) const { origin_->fail(locator(), key_, what); }
-
- private:
-  // The top-level table has no useful line, so messages about it name the file only.
-  const toml::node* locator() const { return top_level_ ? nullptr : table_; }
-
-  const Origin* origin_;
-  const toml::table* table_;
-  std::string key_;
-  bool top_level_;
-};
-
-Table Entry::table() const {
-  const auto* table = node_->as_table();
-  if (table == nullptr) fail(fmt::format("must be a table, got {}", describe(*node_)));
-  return Table(*origin_, *table, key_);
-}
-
-// The blocks of a [[block]] array, keyed block[0], block[1], ...
-std::vector<Table> Entry::tables(std::string_view block) const {
-  if (!node_->is_array_of_tables()) {
-    fail(
-        fmt::format("must be [[{}]] blocks (an array of tables), got {}", block, describe(*node_)));
-  }
-  std::vector<Table> blocks;
-  for (const auto& element : elements(0, "")) blocks.push_back(element.table());
-  return blocks;
-}
-
-double positive(const Entry& entry) {
-  const double value = entry.number();
-  if (!(value > 0.0)) entry.fail(fmt::format("must be > 0, got {}", value));
-  return value;
-}
-
-double non_negative(const Entry& entry) {
-  const double value = entry.number();
-  if (!(value >= 0.0)) entry.fail(fmt::format("must be >= 0, got {}", value));
-  return value;
-}
-
-long integer_at_least(const Entry& entry, long lowest) {
-  const long value = entry.integer();
-  if (value < lowest) entry.fail(fmt::format("must be >= {}, got {}", lowest, value));
-  return value;
-}
-
-// An index into 0 .. count-1 along one grid direction.
-int grid_index(const Entry& entry, int count, std::string_view direction) {
-  const long value = entry.integer();
-  if (value < 0 || value >= count) {
-    entry.fail(fmt::format("{} = {} is outside the grid: must be in 0 .. {}", direction, value,
-                           count - 1));
-  }
-  return static_cast<int>(value);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -521,6 +307,16 @@ void read_time(const Table& time, Scene& scene) {
 // ---------------------------------------------------------------------------------------------
 // Node sets: a list of [k, l] pairs or a region in grid index space
 
+// An index into 0 .. count-1 along one grid direction.
+int grid_index(const Entry& entry, int count, std::string_view direction) {
+  const long value = entry.integer();
+  if (value < 0 || value >= count) {
+    entry.fail(fmt::format("{} = {} is outside the grid: must be in 0 .. {}", direction, value,
+                           count - 1));
+  }
+  return static_cast<int>(value);
+}
+
 NodeIndex node_index(const Entry& entry, const Scene& scene) {
   const auto kl = entry.elements(2, "a node [k, l]");
   const long k = kl[0].integer();
@@ -714,16 +510,6 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
     for (const auto& block : loads->tables("load")) scene.loads.push_back(read_load(block, scene));
   }
   warn_if_not_positive_definite(origin, scene);
-}
-
-toml::table parse_toml(const std::string& text, const Origin& origin) {
-  try {
-    return toml::parse(text, origin.path());
-  } catch (const toml::parse_error& error) {
-    throw SceneError(fmt::format("{}:{}:{}: not valid TOML: {}", origin.path(),
-                                 error.source().begin.line, error.source().begin.column,
-                                 error.description()));
-  }
 }
 
 }  // namespace
