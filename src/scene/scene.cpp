@@ -1,8 +1,10 @@
-// Scene loader: TOML text -> validated Scene (shared/spec/SCENE_FORMAT.md).
+// Scene loader: TOML text -> validated Scene (shared/spec/SCENE_FORMAT.md). This file holds the
+// sections: what each accepts, its defaults, and the order they depend on one another.
 //
 // Every rejection is one line that starts with the file (and the line the value came from, or
 // "(from --set)"), names the full dotted key and says what is allowed, so a user can fix a
-// scene without reading this file.
+// scene without reading this file. checked_toml.hpp gives every message that shape, and
+// overrides.hpp applies --set before any section is read, so overrides are checked alike.
 
 #include "cosserat/scene/scene.hpp"
 
@@ -16,327 +18,36 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <initializer_list>
 #include <sstream>
 #include <string_view>
+
+#include "checked_toml.hpp"
+#include "overrides.hpp"
 
 namespace cosserat {
 namespace {
 
-// Source name of values parsed from --set arguments.
-constexpr std::string_view kSetSource = "--set";
-
-std::string_view trim(std::string_view text) {
-  const auto first = text.find_first_not_of(" \t");
-  if (first == std::string_view::npos) return {};
-  const auto last = text.find_last_not_of(" \t");
-  return text.substr(first, last - first + 1);
-}
+using namespace scene_detail;
 
 std::string joined(const std::vector<std::string>& words) {
   return fmt::format("{}", fmt::join(words, ", "));
 }
 
-// What a user wrote, for "got ..." in messages.
-std::string describe(const toml::node& node) {
-  if (const auto* text = node.as_string()) return fmt::format("the string \"{}\"", text->get());
-  if (const auto* integer = node.as_integer()) return fmt::format("the integer {}", integer->get());
-  if (const auto* real = node.as_floating_point()) return fmt::format("the number {}", real->get());
-  if (const auto* boolean = node.as_boolean()) return fmt::format("the boolean {}", boolean->get());
-  if (const auto* array = node.as_array()) {
-    return fmt::format("an array of {} entries", array->size());
-  }
-  if (node.is_table()) return "a table";
-  return "a date or time";
-}
-
-// The file messages point into. Values whose source is not that file came from --set.
-class Origin {
- public:
-  explicit Origin(std::string path) : path_(std::move(path)) {}
-
-  const std::string& path() const { return path_; }
-
-  // "file:line", "file (from --set)", or "file" when there is no node to point at.
-  std::string locate(const toml::node* node) const {
-    if (node == nullptr) return path_;
-    const auto& source = node->source();
-    if (!source.path || *source.path != path_) return path_ + " (from --set)";
-    return fmt::format("{}:{}", path_, source.begin.line);
-  }
-
-  [[noreturn]] void fail(const toml::node* node, std::string_view key,
-                         std::string_view what) const {
-    throw SceneError(fmt::format("{}: key '{}': {}", locate(node), key, what));
-  }
-
- private:
-  std::string path_;
-};
-
-class Table;
-
-// One value of the scene with its full dotted key; the typed readers reject anything else.
-class Field {
- public:
-  Field(const Origin& origin, const toml::node& node, std::string key)
-      : origin_(&origin), node_(&node), key_(std::move(key)) {}
-
-  [[noreturn]] void fail(std::string_view what) const { origin_->fail(node_, key_, what); }
-
-  // Integers are accepted where numbers are expected; inf and nan never are.
-  double number() const {
-    double value = 0.0;
-    if (const auto* integer = node_->as_integer()) {
-      value = static_cast<double>(integer->get());
-    } else if (const auto* real = node_->as_floating_point()) {
-      value = real->get();
-    } else {
-      fail(fmt::format("must be a number, got {}", describe(*node_)));
-    }
-    if (!std::isfinite(value)) fail(fmt::format("must be a finite number, got {}", value));
-    return value;
-  }
-
-  long integer() const {
-    const auto* integer = node_->as_integer();
-    if (integer == nullptr) fail(fmt::format("must be an integer, got {}", describe(*node_)));
-    return integer->get();
-  }
-
-  std::string string() const {
-    const auto* text = node_->as_string();
-    if (text == nullptr) fail(fmt::format("must be a string, got {}", describe(*node_)));
-    return text->get();
-  }
-
-  // The elements of an array of `size` entries (any size when 0); `what` names the expected form.
-  std::vector<Field> elements(std::size_t size, std::string_view what) const {
-    const auto* array = node_->as_array();
-    if (array == nullptr || (size != 0 && array->size() != size)) {
-      fail(fmt::format("must be {}, got {}", what, describe(*node_)));
-    }
-    std::vector<Field> fields;
-    for (std::size_t i = 0; i < array->size(); ++i) {
-      fields.emplace_back(*origin_, (*array)[i], fmt::format("{}[{}]", key_, i));
-    }
-    return fields;
-  }
-
-  Vec3 vector3() const {
-    const auto entries = elements(3, "an array of 3 numbers [x, y, z]");
-    return {entries[0].number(), entries[1].number(), entries[2].number()};
-  }
-
-  // A material tensor: one number (isotropic) or [t11, t12, t22].
-  Sym2 tensor() const {
-    if (node_->is_number()) {
-      const double value = number();
-      return {value, value, value};
-    }
-    if (!node_->is_array()) {
-      fail(fmt::format("must be a number or an array of 3 numbers [t11, t12, t22], got {}",
-                       describe(*node_)));
-    }
-    const auto entries = elements(3, "a number or an array of 3 numbers [t11, t12, t22]");
-    return {entries[0].number(), entries[1].number(), entries[2].number()};
-  }
-
-  Table table() const;
-  std::vector<Table> tables(std::string_view block) const;
-
- private:
-  const Origin* origin_;
-  const toml::node* node_;
-  std::string key_;
-};
-
-// One TOML table with its dotted key ("" for the top level).
-class Table {
- public:
-  Table(const Origin& origin, const toml::table& table, std::string key, bool top_level = false)
-      : origin_(&origin), table_(&table), key_(std::move(key)), top_level_(top_level) {}
-
-  std::string key_of(std::string_view name) const {
-    return key_.empty() ? std::string(name) : fmt::format("{}.{}", key_, name);
-  }
-
-  // Rejects the first key not in `allowed`: a typo must not silently become a default.
-  void allow(std::initializer_list<std::string_view> allowed) const {
-    for (auto&& [name, node] : *table_) {
-      if (std::find(allowed.begin(), allowed.end(), name.str()) == allowed.end()) {
-        Field(*origin_, node, key_of(name.str()))
-            .fail(fmt::format("unknown key; allowed here: {}", fmt::join(allowed, ", ")));
-      }
-    }
-  }
-
-  std::optional<Field> find(std::string_view name) const {
-    const auto* node = table_->get(name);
-    if (node == nullptr) return std::nullopt;
-    return Field(*origin_, *node, key_of(name));
-  }
-
-  std::optional<Table> find_table(std::string_view name) const {
-    if (const auto field = find(name)) return field->table();
-    return std::nullopt;
-  }
-
-  // `what` says what the missing key should hold.
-  [[noreturn]] void missing(std::string_view name, std::string_view what) const {
-    origin_->fail(locator(), key_of(name), fmt::format("required: {}", what));
-  }
-
-  Field require(std::string_view name, std::string_view what) const {
-    if (auto field = find(name)) return *field;
-    missing(name, what);
-  }
-
-  Table require_table(std::string_view name, std::string_view what) const {
-    if (auto table = find_table(name)) return *table;
-    missing(name, what);
-  }
-
-  [[noreturn]] void fail(std::string_view what) const { origin_->fail(locator(), key_, what); }
-
- private:
-  // The top-level table has no useful line, so messages about it name the file only.
-  const toml::node* locator() const { return top_level_ ? nullptr : table_; }
-
-  const Origin* origin_;
-  const toml::table* table_;
-  std::string key_;
-  bool top_level_;
-};
-
-Table Field::table() const {
-  const auto* table = node_->as_table();
-  if (table == nullptr) fail(fmt::format("must be a table, got {}", describe(*node_)));
-  return Table(*origin_, *table, key_);
-}
-
-// The blocks of a [[block]] array, keyed block[0], block[1], ...
-std::vector<Table> Field::tables(std::string_view block) const {
-  if (!node_->is_array_of_tables()) {
-    fail(
-        fmt::format("must be [[{}]] blocks (an array of tables), got {}", block, describe(*node_)));
-  }
-  std::vector<Table> blocks;
-  for (const auto& element : elements(0, "")) blocks.push_back(element.table());
-  return blocks;
-}
-
-double positive(const Field& field) {
-  const double value = field.number();
-  if (!(value > 0.0)) field.fail(fmt::format("must be > 0, got {}", value));
-  return value;
-}
-
-double non_negative(const Field& field) {
-  const double value = field.number();
-  if (!(value >= 0.0)) field.fail(fmt::format("must be >= 0, got {}", value));
-  return value;
-}
-
-long integer_at_least(const Field& field, long lowest) {
-  const long value = field.integer();
-  if (value < lowest) field.fail(fmt::format("must be >= {}, got {}", lowest, value));
-  return value;
-}
-
-// An index into 0 .. count-1 along one grid direction.
-int grid_index(const Field& field, int count, std::string_view direction) {
-  const long value = field.integer();
-  if (value < 0 || value >= count) {
-    field.fail(fmt::format("{} = {} is outside the grid: must be in 0 .. {}", direction, value,
-                           count - 1));
-  }
-  return static_cast<int>(value);
-}
-
-// ---------------------------------------------------------------------------------------------
-// --set overrides
-
-[[noreturn]] void bad_override(const Origin& origin, const std::string& assignment,
-                               std::string_view what) {
-  throw SceneError(fmt::format("{}: --set '{}': {}", origin.path(), assignment, what));
-}
-
-std::vector<std::string> dotted_components(const Origin& origin, const std::string& assignment,
-                                           std::string_view key) {
-  std::vector<std::string> components;
-  std::size_t begin = 0;
-  while (true) {
-    const auto dot = key.find('.', begin);
-    const auto component =
-        trim(key.substr(begin, dot == std::string_view::npos ? dot : dot - begin));
-    if (component.empty()) bad_override(origin, assignment, "empty key; expected dotted.key=value");
-    components.emplace_back(component);
-    if (dot == std::string_view::npos) return components;
-    begin = dot + 1;
-  }
-}
-
-// The value as TOML, or else as the bare text, so `time.integrator=rk4` needs no quotes. Text
-// that opens like an array, table or quoted string was meant as TOML, so a typo in it is an
-// error rather than a string. Parsed under the --set source name so messages about the value
-// say where it came from.
-toml::table override_value(const Origin& origin, const std::string& assignment,
-                           std::string_view text) {
-  try {
-    auto parsed = toml::parse(fmt::format("value = {}", text), std::string(kSetSource));
-    if (parsed.size() == 1 && parsed.contains("value")) return parsed;
-  } catch (const toml::parse_error& error) {
-    if (!text.empty() && std::string_view("[{\"'").find(text.front()) != std::string_view::npos) {
-      bad_override(origin, assignment, fmt::format("not a TOML value: {}", error.description()));
-    }
-  }
-  toml::table bare;
-  bare.insert("value", std::string(text));
-  return bare;
-}
-
-void apply_override(toml::table& document, const std::string& assignment, const Origin& origin) {
-  const auto equals = assignment.find('=');
-  if (equals == std::string::npos) bad_override(origin, assignment, "expected dotted.key=value");
-  const auto components =
-      dotted_components(origin, assignment, std::string_view(assignment).substr(0, equals));
-
-  toml::table* table = &document;
-  std::string prefix;
-  for (std::size_t i = 0; i + 1 < components.size(); ++i) {
-    prefix += (i == 0 ? "" : ".") + components[i];
-    toml::node* node = table->get(components[i]);
-    if (node == nullptr) node = &table->insert(components[i], toml::table{}).first->second;
-    table = node->as_table();
-    if (table == nullptr) {
-      bad_override(origin, assignment,
-                   fmt::format("'{}' is {}, not a table", prefix, describe(*node)));
-    }
-  }
-  auto value =
-      override_value(origin, assignment, trim(std::string_view(assignment).substr(equals + 1)));
-  table->insert_or_assign(components.back(), std::move(*value.get("value")));
-}
-
-// ---------------------------------------------------------------------------------------------
-// Sections of the scene
-
-int node_count(const Field& field) {
-  const long count = field.integer();
+int node_count(const Entry& entry) {
+  const long count = entry.integer();
   if (count < 3) {
-    field.fail(fmt::format("must be >= 3 (grids smaller than 3x3 are rejected), got {}", count));
+    entry.fail(fmt::format("must be >= 3 (grids smaller than 3x3 are rejected), got {}", count));
   }
-  if (count > INT_MAX) field.fail(fmt::format("must be <= {}, got {}", INT_MAX, count));
+  if (count > INT_MAX) entry.fail(fmt::format("must be <= {}, got {}", INT_MAX, count));
   return static_cast<int>(count);
 }
 
 // A direction of the rest sheet, normalised. Scaled by its largest entry first so that huge
 // or tiny entries neither overflow nor underflow the norm.
-Vec3 unit_direction(const Field& field) {
-  const Vec3 given = field.vector3();
+Vec3 unit_direction(const Entry& entry) {
+  const Vec3 given = entry.vector3();
   const double largest = std::max({std::abs(given.x), std::abs(given.y), std::abs(given.z)});
-  if (largest == 0.0) field.fail("must not be zero-length: it is the direction of a grid axis");
+  if (largest == 0.0) entry.fail("must not be zero-length: it is the direction of a grid axis");
   const Vec3 scaled = given / largest;
   return scaled / norm(scaled);
 }
@@ -363,18 +74,18 @@ void read_grid(const Table& grid, Scene& scene) {
   // Relative to |u||v| = 1 after normalisation.
   if (norm(cross(scene.u, scene.v)) < 1e-12) {
     // The defaults are perpendicular, so at least one of the two was given.
-    const Field& blamed = v ? *v : *u;
+    const Entry& blamed = v ? *v : *u;
     blamed.fail(fmt::format("must not be parallel to grid.{} (u and v span the rest sheet)",
                             v ? "u" : "v"));
   }
 }
 
-Preset preset_named(const Field& field) {
-  const std::string name = field.string();
+Preset preset_named(const Entry& entry) {
+  const std::string name = entry.string();
   if (auto preset = find_preset(name)) return *preset;
   std::vector<std::string> names;
   for (const auto& preset : material_presets()) names.push_back(preset.name);
-  field.fail(fmt::format("unknown preset \"{}\"; allowed: {}", name, joined(names)));
+  entry.fail(fmt::format("unknown preset \"{}\"; allowed: {}", name, joined(names)));
 }
 
 enum class Bound { positive, non_negative, any };
@@ -382,20 +93,20 @@ enum class Bound { positive, non_negative, any };
 // zeta, xi or phi: from the table when given, else isotropic from the preset, else required.
 Sym2 material_tensor(const Table& material, std::string_view name,
                      std::optional<double> from_preset, Bound bound) {
-  const auto field = material.find(name);
-  if (!field) {
+  const auto given = material.find(name);
+  if (!given) {
     if (!from_preset) {
       material.missing(name, "a number or an array of 3 numbers [t11, t12, t22] (or a preset)");
     }
     return {*from_preset, *from_preset, *from_preset};
   }
-  const Sym2 tensor = field->tensor();
+  const Sym2 tensor = given->tensor();
   for (const double entry : tensor) {
     if (bound == Bound::positive && !(entry > 0.0)) {
-      field->fail(fmt::format("every entry must be > 0, got {}", entry));
+      given->fail(fmt::format("every entry must be > 0, got {}", entry));
     }
     if (bound == Bound::non_negative && !(entry >= 0.0)) {
-      field->fail(fmt::format("every entry must be >= 0, got {}", entry));
+      given->fail(fmt::format("every entry must be >= 0, got {}", entry));
     }
   }
   return tensor;
@@ -406,7 +117,7 @@ void read_material(const Table& material, Scene& scene) {
   const double area = scene.size1 * scene.size2;
 
   std::optional<Preset> preset;
-  if (const auto field = material.find("preset")) preset = preset_named(*field);
+  if (const auto entry = material.find("preset")) preset = preset_named(*entry);
   auto preset_value = [&](double Preset::*member) {
     return preset ? std::optional<double>((*preset).*member) : std::nullopt;
   };
@@ -484,16 +195,16 @@ LinearSolver read_solver(const Table& solver) {
 
 void read_time(const Table& time, Scene& scene) {
   time.allow({"integrator", "dt", "steps", "output_every", "solver"});
-  if (const auto field = time.find("integrator")) {
-    const std::string name = field->string();
+  if (const auto entry = time.find("integrator")) {
+    const std::string name = entry->string();
     const auto integrator = integrator_from_name(name);
     if (!integrator) {
-      field->fail(
+      entry->fail(
           fmt::format("unknown integrator \"{}\"; allowed: {}", name, joined(integrator_names())));
     }
 #ifndef COSSERAT_HAVE_PETSC
     if (*integrator == Integrator::semi_implicit) {
-      field->fail(
+      entry->fail(
           "the semi-implicit integrator is the PETSc baseline, and this build has no PETSc "
           "(install libpetsc-real-dev and configure with -DCOSSERAT_WITH_PETSC=ON)");
     }
@@ -521,21 +232,31 @@ void read_time(const Table& time, Scene& scene) {
 // ---------------------------------------------------------------------------------------------
 // Node sets: a list of [k, l] pairs or a region in grid index space
 
-NodeIndex node_index(const Field& field, const Scene& scene) {
-  const auto kl = field.elements(2, "a node [k, l]");
+// An index into 0 .. count-1 along one grid direction.
+int grid_index(const Entry& entry, int count, std::string_view direction) {
+  const long value = entry.integer();
+  if (value < 0 || value >= count) {
+    entry.fail(fmt::format("{} = {} is outside the grid: must be in 0 .. {}", direction, value,
+                           count - 1));
+  }
+  return static_cast<int>(value);
+}
+
+NodeIndex node_index(const Entry& entry, const Scene& scene) {
+  const auto kl = entry.elements(2, "a node [k, l]");
   const long k = kl[0].integer();
   const long l = kl[1].integer();
   if (k < 0 || k >= scene.m || l < 0 || l >= scene.n) {
-    field.fail(
+    entry.fail(
         fmt::format("node [{}, {}] is outside the {}x{} grid: k must be in 0 .. {}, l in 0 .. {}",
                     k, l, scene.m, scene.n, scene.m - 1, scene.n - 1));
   }
   return {static_cast<int>(k), static_cast<int>(l)};
 }
 
-NodeSet node_list(const Field& field, const Scene& scene) {
+NodeSet node_list(const Entry& list, const Scene& scene) {
   NodeSet set;
-  for (const auto& entry : field.elements(0, "an array of nodes [[k, l], ...]")) {
+  for (const auto& entry : list.elements(0, "an array of nodes [[k, l], ...]")) {
     const NodeIndex node = node_index(entry, scene);
     // A repeated node would double a load on it.
     if (std::find(set.nodes.begin(), set.nodes.end(), node) != set.nodes.end()) {
@@ -543,19 +264,19 @@ NodeSet node_list(const Field& field, const Scene& scene) {
     }
     set.nodes.push_back(node);
   }
-  if (set.nodes.empty()) field.fail("must list at least one node [k, l]");
+  if (set.nodes.empty()) list.fail("must list at least one node [k, l]");
   return set;
 }
 
 // Inclusive corners [k0, l0, k1, l1]; nodes in x1-fastest order like the fields.
-NodeSet rect_nodes(const Field& field, const Scene& scene) {
-  const auto corners = field.elements(4, "an array of 4 integers [k0, l0, k1, l1]");
+NodeSet rect_nodes(const Entry& entry, const Scene& scene) {
+  const auto corners = entry.elements(4, "an array of 4 integers [k0, l0, k1, l1]");
   const int k0 = grid_index(corners[0], scene.m, "k0");
   const int l0 = grid_index(corners[1], scene.n, "l0");
   const int k1 = grid_index(corners[2], scene.m, "k1");
   const int l1 = grid_index(corners[3], scene.n, "l1");
   if (k0 > k1 || l0 > l1) {
-    field.fail(fmt::format("needs k0 <= k1 and l0 <= l1, got [{}, {}, {}, {}]", k0, l0, k1, l1));
+    entry.fail(fmt::format("needs k0 <= k1 and l0 <= l1, got [{}, {}, {}, {}]", k0, l0, k1, l1));
   }
   NodeSet set;
   for (int l = l0; l <= l1; ++l) {
@@ -566,10 +287,10 @@ NodeSet rect_nodes(const Field& field, const Scene& scene) {
 
 // Nodes with (k - ck)^2 + (l - cl)^2 <= r^2. The centre may fall between nodes so that a disk
 // can sit in the middle of a grid with an even node count.
-NodeSet disk_nodes(const Field& field, const Scene& scene) {
-  const Table disk = field.table();
+NodeSet disk_nodes(const Entry& entry, const Scene& scene) {
+  const Table disk = entry.table();
   disk.allow({"center", "radius"});
-  const Field center = disk.require("center", "an array of 2 numbers [k, l] inside the grid");
+  const Entry center = disk.require("center", "an array of 2 numbers [k, l] inside the grid");
   const auto kl = center.elements(2, "an array of 2 numbers [k, l] inside the grid");
   const double ck = kl[0].number();
   const double cl = kl[1].number();
@@ -584,14 +305,14 @@ NodeSet disk_nodes(const Field& field, const Scene& scene) {
     }
   }
   if (set.nodes.empty()) {
-    field.fail(fmt::format("selects no node (center [{}, {}], radius {}); make the radius larger",
+    entry.fail(fmt::format("selects no node (center [{}, {}], radius {}); make the radius larger",
                            ck, cl, radius));
   }
   return set;
 }
 
-NodeSet region_nodes(const Field& field, const Scene& scene) {
-  const Table region = field.table();
+NodeSet region_nodes(const Entry& entry, const Scene& scene) {
+  const Table region = entry.table();
   region.allow({"rect", "disk", "row", "column"});
   const auto rect = region.find("rect");
   const auto disk = region.find("disk");
@@ -640,15 +361,15 @@ void read_window(const Table& block, Constraint& constraint) {
   }
 }
 
-std::array<bool, 3> held_axes(const Field& field) {
-  const std::string letters = field.string();
+std::array<bool, 3> held_axes(const Entry& entry) {
+  const std::string letters = entry.string();
   if (letters.empty()) {
-    field.fail("a fix with no axes holds nothing; give any of x, y, z (default \"xyz\")");
+    entry.fail("a fix with no axes holds nothing; give any of x, y, z (default \"xyz\")");
   }
   std::array<bool, 3> axes{false, false, false};
   for (const char letter : letters) {
     if (letter < 'x' || letter > 'z') {
-      field.fail(
+      entry.fail(
           fmt::format("unknown axis '{}' in \"{}\"; allowed letters: x, y, z", letter, letters));
     }
     axes[letter - 'x'] = true;
@@ -714,16 +435,6 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
     for (const auto& block : loads->tables("load")) scene.loads.push_back(read_load(block, scene));
   }
   warn_if_not_positive_definite(origin, scene);
-}
-
-toml::table parse_toml(const std::string& text, const Origin& origin) {
-  try {
-    return toml::parse(text, origin.path());
-  } catch (const toml::parse_error& error) {
-    throw SceneError(fmt::format("{}:{}:{}: not valid TOML: {}", origin.path(),
-                                 error.source().begin.line, error.source().begin.column,
-                                 error.description()));
-  }
 }
 
 }  // namespace
