@@ -1,0 +1,108 @@
+// The one place a per-step action hooks in (Stepper::add_action): it runs on every step of
+// every scheme, on the proposed state, before the stability check accepts it.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "cosserat/baseline/semi_implicit.hpp"
+#include "support/sheets.hpp"
+
+namespace cosserat {
+namespace {
+
+// A floor y ≥ floor_height that stops what reaches it: the simplest position-and-velocity
+// response, as a contact response will be.
+class Floor final : public StepAction {
+ public:
+  Floor(const Block& block, double height, std::vector<long>& steps_seen)
+      : block_(&block), height_(height), steps_seen_(&steps_seen) {}
+
+  void apply(ProposedStep& proposed) override {
+    steps_seen_->push_back(proposed.step);
+    const Block& b = *block_;
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k) {
+        Vec3& r = proposed.next_positions(k, l);
+        if (r.y > height_) continue;
+        r.y = height_;
+        if (proposed.next_velocities != nullptr) (*proposed.next_velocities)(k, l).y = 0.0;
+      }
+  }
+
+ private:
+  const Block* block_;
+  double height_;
+  std::vector<long>* steps_seen_;
+};
+
+class EverySchemeWithAnAction : public ::testing::TestWithParam<Integrator> {};
+
+// A sheet falls 0.2 m onto the floor: the action sees every step once, in order, and every
+// accepted state lies on or above the floor; free fall alone would take it 1.2 m below.
+TEST_P(EverySchemeWithAnAction, SeesEveryStepAndItsChangesAreAccepted) {
+  Scene scene = testing::flat_sheet(6, 5);
+  scene.integrator = GetParam();
+  scene.gravity = {0.0, -9.8, 0.0};
+  scene.dt = 1e-3;
+  const double floor_height = -0.2;
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
+  std::vector<long> steps_seen;
+  sim.stepper().add_action(std::make_unique<Floor>(sim.block(), floor_height, steps_seen));
+  const long steps = 500;
+  ASSERT_TRUE(testing::advance(sim, steps));
+  ASSERT_EQ(steps_seen.size(), static_cast<std::size_t>(steps));
+  for (long s = 0; s < steps; ++s) EXPECT_EQ(steps_seen[static_cast<std::size_t>(s)], s + 1);
+  double lowest = 0.0;
+  for (int l = 0; l < scene.n; ++l)
+    for (int k = 0; k < scene.m; ++k) lowest = std::min(lowest, sim.positions()(k, l).y);
+  EXPECT_EQ(lowest, floor_height);
+  // Resting on the floor: no node moves down any more.
+  for (int l = 0; l < scene.n; ++l)
+    for (int k = 0; k < scene.m; ++k) EXPECT_GE(sim.velocities()(k, l).y, -1e-12);
+}
+
+// The action runs before the check: a node it throws a whole grid spacing away stops the run
+// at that step, and the state stays at the last good one.
+TEST_P(EverySchemeWithAnAction, RunsBeforeTheStabilityCheck) {
+  Scene scene = testing::flat_sheet(6, 5);
+  scene.integrator = GetParam();
+  class Kick final : public StepAction {
+   public:
+    explicit Kick(double distance) : distance_(distance) {}
+    void apply(ProposedStep& proposed) override {
+      if (proposed.step == 3) proposed.next_positions(2, 2).y += distance_;
+    }
+
+   private:
+    double distance_;
+  };
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
+  sim.stepper().add_action(std::make_unique<Kick>(scene.h1()));
+  ASSERT_TRUE(testing::advance(sim, 2));
+  const auto failure = sim.step();
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_EQ(failure->step, 3);
+  EXPECT_EQ(failure->k, 2);
+  EXPECT_EQ(failure->l, 2);
+  EXPECT_EQ(sim.step_index(), 2);
+}
+
+std::vector<Integrator> every_scheme() {
+  std::vector<Integrator> schemes;
+  for (const std::string& name : integrator_names()) {
+    const Integrator scheme = *integrator_from_name(name);
+#if !defined(COSSERAT_HAVE_PETSC)
+    if (scheme == Integrator::semi_implicit) continue;
+#endif
+    schemes.push_back(scheme);
+  }
+  return schemes;
+}
+
+INSTANTIATE_TEST_SUITE_P(Schemes, EverySchemeWithAnAction, ::testing::ValuesIn(every_scheme()),
+                         testing::scheme_test_name);
+
+}  // namespace
+}  // namespace cosserat
