@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosserat/baseline/semi_implicit.hpp"
@@ -21,6 +22,7 @@
 #include "cosserat/grid/reduce.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
+#include "cosserat/io/stable_dt_table.hpp"
 #include "cosserat/io/summary.hpp"
 #include "cosserat/model/wave_speed.hpp"
 #include "cosserat/scene/scene.hpp"
@@ -330,9 +332,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
     fmt::print("{:<17} {:>12} {:>12} {:>7} {:>7} {:>9}  {}\n", "integrator", "stable dt",
                "unstable dt", "/ CFL", "trials", "wall s", "first unstable trial");
   }
-  std::string csv =
-      "scene,integrator,duration,stable_dt,unstable_dt,cfl_dt,stable_over_cfl,trials,"
-      "wall_seconds,cause\n";
+  StableDtTable table{title, duration, cfl.dt, {}};
   for (const Scene& scene : scenes) {
     const std::string name = integrator_name(scene.integrator);
     StableStep found;
@@ -346,32 +346,22 @@ int stable_dt(const StableDtOptions& options, int rank) {
           found = largest_stable_step(scene, duration, options.tolerance, MPI_COMM_WORLD, report);
         }))
       return *failed;
-    double wall = 0.0;
-    std::string cause;
-    for (const StabilityTrial& t : found.trials) {
-      wall += t.wall_seconds;
-      if (!t.stable && t.dt == found.unstable_dt) cause = t.cause;
-    }
-    if (found.unstable_dt == 0.0) cause = fmt::format("stable up to dt = T = {} s", duration);
-    if (found.stable_dt == 0.0) cause = "no stable step down to 1e-6 of the scene's dt; " + cause;
+    const StableDtRow& row =
+        table.rows.emplace_back(stable_dt_row(name, std::move(found), duration));
     if (rank == 0) {
       fmt::print("{:<17} {:>12.6g} {:>12.6g} {:>7.3f} {:>7} {:>9.2f}  {}\n", name,
-                 found.stable_dt, found.unstable_dt, found.stable_dt / cfl.dt,
-                 found.trials.size(), wall, cause);
+                 row.found.stable_dt, row.found.unstable_dt, row.found.stable_dt / cfl.dt,
+                 row.found.trials.size(), row.wall_seconds, row.cause);
       std::fflush(stdout);
     }
-    csv += fmt::format("\"{}\",{},{},{},{},{},{},{},{},\"{}\"\n", title, name, duration,
-                       found.stable_dt, found.unstable_dt, cfl.dt, found.stable_dt / cfl.dt,
-                       found.trials.size(), wall, cause);
   }
   if (rank == 0 && !options.csv.empty()) {
-    std::FILE* file = std::fopen(options.csv.c_str(), "w");
-    if (file == nullptr) {
-      fmt::print(stderr, "error: cannot write {}\n", options.csv);
+    try {
+      write_csv(options.csv, table);
+    } catch (const std::runtime_error& e) {
+      fmt::print(stderr, "error: {}\n", e.what());
       return kExitFailure;
     }
-    std::fputs(csv.c_str(), file);
-    std::fclose(file);
   }
   return kExitOk;
 }
