@@ -1,4 +1,5 @@
-// The `cosserat` command line (DESIGN.md "Interfaces"): owns MPI, files and the step loop.
+// The `cosserat` command line (DESIGN.md "Interfaces"): owns MPI, the options and the files; the
+// step loop (time/step_loop.hpp) says when a frame or a checkpoint is due.
 
 #include <mpi.h>
 #include <omp.h>
