@@ -1,4 +1,5 @@
-// The `cosserat` command line (DESIGN.md "Interfaces"): owns MPI, files and the step loop.
+// The `cosserat` command line (DESIGN.md "Interfaces"): owns MPI, the options and the files; the
+// step loop (time/step_loop.hpp) says when a frame or a checkpoint is due.
 
 #include <mpi.h>
 #include <omp.h>
@@ -14,6 +15,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosserat/baseline/semi_implicit.hpp"
@@ -21,11 +23,13 @@
 #include "cosserat/grid/reduce.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
+#include "cosserat/io/stable_dt_table.hpp"
 #include "cosserat/io/summary.hpp"
 #include "cosserat/model/wave_speed.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/simulation.hpp"
 #include "cosserat/time/stability.hpp"
+#include "cosserat/time/step_loop.hpp"
 
 #if defined(COSSERAT_TRAP_FPE)
 #include <cfenv>
@@ -89,6 +93,34 @@ class Progress {
   double dt_;
   bool enabled_;
   Clock::time_point start_, last_;
+};
+
+// The step loop says when a frame or a checkpoint is due; the files and the progress line are
+// the command line's.
+class RunObserver : public cosserat::StepObserver {
+ public:
+  RunObserver(cosserat::Simulation& simulation, const cosserat::Scene& scene,
+              cosserat::FrameWriter& writer, const std::string& checkpoint, Progress& progress)
+      : simulation_(simulation),
+        scene_(scene),
+        writer_(writer),
+        checkpoint_(checkpoint),
+        progress_(progress) {}
+
+  void frame() override {
+    writer_.write_frame(simulation_.step_index(), simulation_.time(), simulation_.positions());
+  }
+  void checkpoint() override {
+    cosserat::write_checkpoint(checkpoint_, simulation_, scene_, COSSERAT_VERSION);
+  }
+  void progress(long step) override { progress_.update(step); }
+
+ private:
+  cosserat::Simulation& simulation_;
+  const cosserat::Scene& scene_;
+  cosserat::FrameWriter& writer_;
+  const std::string& checkpoint_;
+  Progress& progress_;
 };
 
 std::string default_output(const cosserat::Scene& scene) { return scene.name + ".h5"; }
@@ -201,43 +233,21 @@ int run(const RunOptions& options, int rank, int ranks) {
       fmt::print("restarted from {} at step {}\n", options.restart, *restarted_from);
   }
 
-  auto write_frame = [&] {
-    writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions());
-  };
   // A continued file already holds every scheduled frame up to the checkpoint; a new file starts
   // with the state the run starts from.
-  if (!continued) write_frame();
-  const long first_step = simulation.step_index();
-  const double halo_before = simulation.halo_seconds();
+  if (!continued)
+    writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions());
+
   Progress progress(scene.steps, scene.dt, on_terminal);
-  const auto start = Clock::now();
-  std::optional<Instability> failure;
-  std::optional<RestSummary> rest;
-  if (options.until_rest) rest = RestSummary{*options.until_rest, 0.0, std::nullopt};
-  while (simulation.step_index() < scene.steps) {
-    failure = simulation.step();
-    if (failure) break;
-    const long step = simulation.step_index();
-    bool at_rest = false;
-    if (rest) {
-      const double energy = simulation.diagnostics().kinetic_energy;
-      rest->peak_kinetic_energy = std::max(rest->peak_kinetic_energy, energy);
-      at_rest = energy < rest->fraction * rest->peak_kinetic_energy;
-      if (at_rest) rest->step = step;
-    }
-    if (step % scene.output_every == 0 || step == scene.steps || at_rest) write_frame();
-    if (options.checkpoint_every > 0 &&
-        (step % options.checkpoint_every == 0 || step == scene.steps))
-      write_checkpoint(checkpoint, simulation, scene, COSSERAT_VERSION);
-    progress.update(step);
-    if (at_rest) break;
-  }
-  const double wall = std::chrono::duration<double>(Clock::now() - start).count();
+  RunObserver observer(simulation, scene, *writer, checkpoint, progress);
+  const StepLoopResult loop = run_step_loop(
+      simulation, scene, StepLoopOptions{options.checkpoint_every, options.until_rest}, observer);
   progress.finish();
 
+  const std::optional<Instability>& failure = loop.failure;
   if (failure) {
     // Keep the last good state: it is the newest frame unless it was just written.
-    if (writer->last_step() != simulation.step_index()) write_frame();
+    if (writer->last_step() != simulation.step_index()) observer.frame();
     if (rank == 0)
       fmt::print(stderr,
                  "error: unstable at step {} (t = {:.6g} s): {}; stopped, the last good state "
@@ -249,34 +259,13 @@ int run(const RunOptions& options, int rank, int ranks) {
     writer->set_attribute("status", "ok");
   }
 
-  const Diagnostics diagnostics = simulation.diagnostics();
-  const double steps_run = static_cast<double>(simulation.step_index() - first_step);
-  RunSummary summary;
-  summary.scene = scene.title.empty() ? scene.name : scene.title;
-  summary.m = scene.m;
-  summary.n = scene.n;
-  summary.ranks = ranks;
-  summary.threads = threads;
-  summary.parts_k = decomposition->parts_k();
-  summary.parts_l = decomposition->parts_l();
-  summary.integrator = integrator_name(scene.integrator);
-  summary.dt = scene.dt;
-  summary.steps = simulation.step_index();
-  summary.sim_time = simulation.time();
-  summary.wall_seconds = wall;
-  summary.node_steps_per_second =
-      wall > 0.0 ? static_cast<double>(scene.m) * scene.n * steps_run / wall : 0.0;
-  summary.halo_seconds = global_max(simulation.halo_seconds() - halo_before, MPI_COMM_WORLD);
-  summary.restarted_from = restarted_from;
-  summary.status = failure ? "unstable" : "ok";
-  if (failure) summary.unstable_step = failure->step;
-  summary.area_ratio = diagnostics.area_ratio;
-  summary.max_speed = diagnostics.max_speed;
-  summary.kinetic_energy = diagnostics.kinetic_energy;
-  summary.center_of_mass = diagnostics.center_of_mass;
-  summary.output = output;
-  summary.linear_solves = simulation.stepper().linear_solves();
-  summary.rest = rest;
+  const RunSummary summary =
+      summarize_run(scene, simulation, loop,
+                    RunPlacement{ranks, threads, decomposition->parts_k(), decomposition->parts_l(),
+                                 output, restarted_from},
+                    MPI_COMM_WORLD);
+  const double steps_run = static_cast<double>(summary.steps - loop.first_step);
+  const double wall = summary.wall_seconds;
   if (rank == 0) {
     if (!options.summary.empty()) write_summary(options.summary, summary);
     if (!options.quiet)
@@ -290,7 +279,7 @@ int run(const RunOptions& options, int rank, int ranks) {
                  "linear solves {:.3f} s\n",
                  l->solves > 0 ? static_cast<double>(l->iterations) / l->solves : 0.0,
                  l->most_iterations, l->jacobian_seconds, l->solve_seconds);
-    if (rest && !options.quiet)
+    if (const auto& rest = summary.rest; rest && !options.quiet)
       fmt::print("{}\n", rest->step ? fmt::format("at rest at step {}", *rest->step)
                                     : std::string("not at rest by the last step"));
   }
@@ -331,9 +320,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
     fmt::print("{:<17} {:>12} {:>12} {:>7} {:>7} {:>9}  {}\n", "integrator", "stable dt",
                "unstable dt", "/ CFL", "trials", "wall s", "first unstable trial");
   }
-  std::string csv =
-      "scene,integrator,duration,stable_dt,unstable_dt,cfl_dt,stable_over_cfl,trials,"
-      "wall_seconds,cause\n";
+  StableDtTable table{title, duration, cfl.dt, {}};
   for (const Scene& scene : scenes) {
     const std::string name = integrator_name(scene.integrator);
     StableStep found;
@@ -348,32 +335,22 @@ int stable_dt(const StableDtOptions& options, int rank) {
                                       any_scheme, report);
         }))
       return *failed;
-    double wall = 0.0;
-    std::string cause;
-    for (const StabilityTrial& t : found.trials) {
-      wall += t.wall_seconds;
-      if (!t.stable && t.dt == found.unstable_dt) cause = t.cause;
-    }
-    if (found.unstable_dt == 0.0) cause = fmt::format("stable up to dt = T = {} s", duration);
-    if (found.stable_dt == 0.0) cause = "no stable step down to 1e-6 of the scene's dt; " + cause;
+    const StableDtRow& row =
+        table.rows.emplace_back(stable_dt_row(name, std::move(found), duration));
     if (rank == 0) {
       fmt::print("{:<17} {:>12.6g} {:>12.6g} {:>7.3f} {:>7} {:>9.2f}  {}\n", name,
-                 found.stable_dt, found.unstable_dt, found.stable_dt / cfl.dt,
-                 found.trials.size(), wall, cause);
+                 row.found.stable_dt, row.found.unstable_dt, row.found.stable_dt / cfl.dt,
+                 row.found.trials.size(), row.wall_seconds, row.cause);
       std::fflush(stdout);
     }
-    csv += fmt::format("\"{}\",{},{},{},{},{},{},{},{},\"{}\"\n", title, name, duration,
-                       found.stable_dt, found.unstable_dt, cfl.dt, found.stable_dt / cfl.dt,
-                       found.trials.size(), wall, cause);
   }
   if (rank == 0 && !options.csv.empty()) {
-    std::FILE* file = std::fopen(options.csv.c_str(), "w");
-    if (file == nullptr) {
-      fmt::print(stderr, "error: cannot write {}\n", options.csv);
+    try {
+      write_csv(options.csv, table);
+    } catch (const std::runtime_error& e) {
+      fmt::print(stderr, "error: {}\n", e.what());
       return kExitFailure;
     }
-    std::fputs(csv.c_str(), file);
-    std::fclose(file);
   }
   return kExitOk;
 }

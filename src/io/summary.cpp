@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "cosserat/grid/reduce.hpp"
+
 namespace cosserat {
 namespace {
 
@@ -41,6 +43,40 @@ std::string json_number(double value) {
 }
 
 }  // namespace
+
+RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepLoopResult& loop,
+                         const RunPlacement& placement, MPI_Comm comm) {
+  const Diagnostics diagnostics = simulation.diagnostics();
+  const double steps_run = static_cast<double>(simulation.step_index() - loop.first_step);
+  const double wall = loop.wall_seconds;
+  RunSummary summary;
+  summary.scene = scene.title.empty() ? scene.name : scene.title;
+  summary.m = scene.m;
+  summary.n = scene.n;
+  summary.ranks = placement.ranks;
+  summary.threads = placement.threads;
+  summary.parts_k = placement.parts_k;
+  summary.parts_l = placement.parts_l;
+  summary.integrator = integrator_name(scene.integrator);
+  summary.dt = scene.dt;
+  summary.steps = simulation.step_index();
+  summary.sim_time = simulation.time();
+  summary.wall_seconds = wall;
+  summary.node_steps_per_second =
+      wall > 0.0 ? static_cast<double>(scene.m) * scene.n * steps_run / wall : 0.0;
+  summary.halo_seconds = global_max(loop.halo_seconds, comm);
+  summary.restarted_from = placement.restarted_from;
+  summary.status = loop.failure ? "unstable" : "ok";
+  if (loop.failure) summary.unstable_step = loop.failure->step;
+  summary.area_ratio = diagnostics.area_ratio;
+  summary.max_speed = diagnostics.max_speed;
+  summary.kinetic_energy = diagnostics.kinetic_energy;
+  summary.center_of_mass = diagnostics.center_of_mass;
+  summary.output = placement.output;
+  summary.linear_solves = simulation.stepper().linear_solves();
+  summary.rest = loop.rest;
+  return summary;
+}
 
 std::string to_json(const RunSummary& s) {
   const std::string unstable_step =

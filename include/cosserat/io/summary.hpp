@@ -2,20 +2,18 @@
 // The run summary: one JSON object whose keys are fixed by shared/DESIGN.md ("Interfaces"),
 // read by scripts that compare runs, so names and types here do not change.
 
+#include <mpi.h>
+
 #include <optional>
 #include <string>
 
-#include "cosserat/time/linear_solve_stats.hpp"
 #include "cosserat/model/vec3.hpp"
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/linear_solve_stats.hpp"
+#include "cosserat/time/simulation.hpp"
+#include "cosserat/time/step_loop.hpp"
 
 namespace cosserat {
-
-// When a run stopped at rest (--until-rest): kinetic energy below `fraction` of its peak.
-struct RestSummary {
-  double fraction = 0.0;
-  double peak_kinetic_energy = 0.0;
-  std::optional<long> step;  // the first step at rest; empty if the run ended before
-};
 
 struct RunSummary {
   std::string scene;
@@ -42,6 +40,20 @@ struct RunSummary {
   std::optional<LinearSolveStats> linear_solves;  // semi-implicit only
   std::optional<RestSummary> rest;                  // with --until-rest only
 };
+
+// How a run was laid out and where it wrote, beside what its scene and step loop say.
+struct RunPlacement {
+  int ranks = 1;
+  int threads = 1;
+  int parts_k = 1, parts_l = 1;
+  std::string output;
+  std::optional<long> restarted_from;
+};
+
+// The summary of a run that ended as `loop` says; collective over comm, since the diagnostics
+// and the halo time are reduced over the ranks.
+RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepLoopResult& loop,
+                         const RunPlacement& placement, MPI_Comm comm);
 
 // Non-finite numbers and an empty unstable_step are written as null, since JSON has no NaN.
 std::string to_json(const RunSummary& summary);

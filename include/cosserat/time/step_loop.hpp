@@ -1,0 +1,56 @@
+#pragma once
+// The step loop of a run (DESIGN.md principle 4: scene -> Simulation -> step loop -> writers):
+// it decides when a frame or a checkpoint is due and when the sheet has come to rest, and leaves
+// what is done then to an observer, so that the time module needs no files and tests can follow
+// the schedule without writing any.
+
+#include <optional>
+
+#include "cosserat/scene/scene.hpp"
+#include "cosserat/time/simulation.hpp"
+#include "cosserat/time/stepper.hpp"
+
+namespace cosserat {
+
+// --until-rest: the run is at rest once its kinetic energy is below `fraction` of its peak so
+// far. The peak is the run's own, so a sheet released from rest is not at rest at its first step.
+struct RestSummary {
+  double fraction = 0.0;
+  double peak_kinetic_energy = 0.0;
+  std::optional<long> step;  // the first step at rest; empty if the run ended before
+
+  // Takes the kinetic energy after `step`; true, with `step` kept, when the run is at rest.
+  bool at_rest(long step, double kinetic_energy);
+};
+
+struct StepLoopOptions {
+  long checkpoint_every = 0;  // 0: no checkpoints
+  std::optional<double> until_rest;
+};
+
+// Told after each good step, in this order: frame and checkpoint when due, then progress. The
+// state they are due for is the simulation's as it is when they are called.
+class StepObserver {
+ public:
+  virtual ~StepObserver() = default;
+  virtual void frame() = 0;
+  virtual void checkpoint() = 0;
+  virtual void progress(long step) = 0;
+};
+
+struct StepLoopResult {
+  long first_step = 0;  // the step the loop started from: 0, or a restart's checkpoint
+  std::optional<Instability> failure;  // the simulation is left at the last good step
+  std::optional<RestSummary> rest;     // with until_rest only
+  double wall_seconds = 0.0;
+  double halo_seconds = 0.0;  // of the wall time, in halo exchanges on this rank
+};
+
+// Steps `simulation` up to scene.steps, stopping early on an instability or at rest. Frames are
+// due every scene.output_every steps, at the last step and at the step at rest; checkpoints every
+// options.checkpoint_every steps and at the last step. Nothing is due for the step the loop
+// starts from, nor for a step that failed. Collective over the simulation's ranks.
+StepLoopResult run_step_loop(Simulation& simulation, const Scene& scene,
+                             const StepLoopOptions& options, StepObserver& observer);
+
+}  // namespace cosserat
