@@ -70,7 +70,11 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   if (loop.failure) summary.unstable_step = loop.failure->step;
   summary.area_ratio = diagnostics.area_ratio;
   summary.max_speed = diagnostics.max_speed;
+  summary.discretisation =
+      scene.discretisation == Discretisation::energy ? "energy" : "flux";
   summary.kinetic_energy = diagnostics.kinetic_energy;
+  summary.elastic_energy = simulation.elastic_energy();
+  summary.gravitational_energy = diagnostics.gravitational_energy;
   summary.center_of_mass = diagnostics.center_of_mass;
   summary.output = placement.output;
   summary.linear_solves = simulation.stepper().linear_solves();
@@ -107,6 +111,7 @@ std::string to_json(const RunSummary& s) {
   "threads": {},
   "split": [{}, {}],
   "integrator": {},
+  "discretisation": {},
   "dt": {},
   "steps": {},
   "sim_time": {},
@@ -119,6 +124,8 @@ std::string to_json(const RunSummary& s) {
   "area_ratio": {},
   "max_speed": {},
   "kinetic_energy": {},
+  "elastic_energy": {},
+  "gravitational_energy": {},
   "center_of_mass": [{}, {}, {}],
   "output": {},
   "linear_solves": {},
@@ -126,11 +133,11 @@ std::string to_json(const RunSummary& s) {
 }}
 )",
       json_string(s.scene), s.m, s.n, s.ranks, s.threads, s.parts_k, s.parts_l,
-      json_string(s.integrator), json_number(s.dt), s.steps, json_number(s.sim_time),
+      json_string(s.integrator), json_string(s.discretisation), json_number(s.dt), s.steps, json_number(s.sim_time),
       json_number(s.wall_seconds), json_number(s.node_steps_per_second),
       json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,
       json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
-      json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest);
+      json_number(s.elastic_energy), json_number(s.gravitational_energy), json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest);
 }
 
 void write_summary(const std::string& path, const RunSummary& summary) {

@@ -143,7 +143,7 @@ void read_material(const Table& material, Scene& scene) {
 }
 
 void read_model(const Table& model, Scene& scene) {
-  model.allow({"kind", "borders"});
+  model.allow({"kind", "discretisation", "borders"});
   if (const auto kind = model.find("kind")) {
     const std::string name = kind->string();
     if (name != "cosserat") {
@@ -159,6 +159,23 @@ void read_model(const Table& model, Scene& scene) {
     } else {
       borders->fail(fmt::format("unknown borders \"{}\"; allowed: symmetric, published", name));
     }
+  }
+  if (const auto discretisation = model.find("discretisation")) {
+    const std::string name = discretisation->string();
+    if (name == "flux") {
+      scene.discretisation = Discretisation::flux;
+    } else if (name == "energy") {
+      scene.discretisation = Discretisation::energy;
+    } else {
+      discretisation->fail(
+          fmt::format("unknown discretisation \"{}\"; allowed: flux, energy", name));
+    }
+    // The energy form's border terms are MODEL.md §2.5's; the published rules are the flux
+    // form's alone.
+    if (scene.discretisation == Discretisation::energy && scene.borders == Borders::published)
+      discretisation->fail(
+          "\"energy\" has no published border rules; use borders = \"symmetric\" (the "
+          "default) or discretisation = \"flux\"");
   }
 }
 

@@ -3,17 +3,23 @@
 #include <cassert>
 #include <cmath>
 
+#include "cosserat/grid/reduce.hpp"
+
 namespace cosserat {
 
 Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions)
     : block_(&block),
-      model_(block, scene.h1(), scene.h2(),
-             flat_rest_state(scene.material, scene.u, scene.v), scene.borders),
+      discretisation_(scene.discretisation),
+      energy_(block, scene.h1(), scene.h2(), flat_rest_state(scene.material, scene.u, scene.v)),
       h1h2_(scene.h1() * scene.h2()),
       // 2⁻⁴⁰ of a grid cell: far below the round-off of a double sum over the cells.
       area_quantum_(std::ldexp(h1h2_, -40)),
       mass_(scene.material.mass),
       rest_area_(total_area(rest_positions)),
+      // μ0 h1 h2 = (M/S0) h1 h2: the lumped constant nodal mass of the energy form.
+      node_mass_(scene.discretisation == Discretisation::energy
+                     ? scene.material.mass / rest_area_ * h1h2_
+                     : scene.material.mass / (static_cast<double>(scene.m) * scene.n)),
       gravity_(scene.gravity),
       damping_(scene.damping),
       fluid_(scene.fluid) {
@@ -21,10 +27,15 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
     for (const NodeIndex& node : load.nodes.nodes)
       if (block.owns(node.k, node.l))
         loads_.push_back(PointLoad{node.k, node.l, load.force, load.start, load.end});
+  if (discretisation_ == Discretisation::flux)
+    flux_.emplace(block, scene.h1(), scene.h2(),
+                  flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
   // μ = M/S enters only through loads, fluid and damping (MODEL.md §3): without them the
-  // current area is never needed during a step.
-  // The area is a collective reduction: decide from the scene, which every rank shares.
-  needs_area_ = !scene.loads.empty() || fluid_.has_value() || damping_ > 0.0;
+  // current area is never needed during a step. The energy form's mass is constant (§2.5), so
+  // it never is. The area is a collective reduction: decide from the scene, which every rank
+  // shares.
+  needs_area_ = discretisation_ == Discretisation::flux &&
+                (!scene.loads.empty() || fluid_.has_value() || damping_ > 0.0);
 }
 
 double Dynamics::total_area(const Field<Vec3>& r) const {
@@ -35,10 +46,19 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
                                           Field<Vec3>* normals) {
   const Block& b = *block_;
   assert((normals != nullptr) == has_fluid());
-  model_.internal_force(r, a, normals);
-  // S/M = 1/μ; the internal force carries f = S0/S, so its acceleration is f̂ S0/M (§3).
-  const double inverse_density = needs_area_ ? total_area(r) / mass_ : 0.0;
-  const double internal_scale = rest_area_ / mass_;
+  double inverse_density = 0.0, internal_scale = 0.0;
+  if (flux_) {
+    flux_->internal_force(r, a, normals);
+    // S/M = 1/μ; the internal force carries f = S0/S, so its acceleration is f̂ S0/M (§3).
+    if (needs_area_) inverse_density = total_area(r) / mass_;
+    internal_scale = rest_area_ / mass_;
+  } else {
+    // Newtons on the constant nodal mass μ0 h1 h2 (§2.5); loads, damping and fluid per unit
+    // area act on μ0.
+    energy_.internal_force(r, a, normals);
+    inverse_density = rest_area_ / mass_;
+    internal_scale = 1.0 / node_mass_;
+  }
   const Vec3 g = gravity_;
   const bool fluid = fluid_.has_value();
   const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
@@ -61,10 +81,20 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
   return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
 }
 
+double Dynamics::elastic_energy(const Field<Vec3>& r) {
+  return global_sum(energy_.block_energy(r), block_->comm);
+}
+
 void Dynamics::internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a) {
   const Block& b = *block_;
-  model_.internal_force(r, a);
-  const double internal_scale = rest_area_ / mass_;
+  double internal_scale = 0.0;
+  if (flux_) {
+    flux_->internal_force(r, a);
+    internal_scale = rest_area_ / mass_;
+  } else {
+    energy_.internal_force(r, a);
+    internal_scale = 1.0 / node_mass_;
+  }
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l);

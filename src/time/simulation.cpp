@@ -45,7 +45,11 @@ double Simulation::memory_bytes(const Block& block, Integrator integrator) {
   const double owned_nodes = static_cast<double>(block.owned_k()) * block.owned_l();
   // rk4 keeps nine position-sized fields (state and new state of r and v, acceleration, two
   // stages, two weighted sums), and a fluid one more for the normals.
-  const double per_node = sizeof(NodeResultants) + 2 * sizeof(Vec3) + 10 * sizeof(Vec3);
+  // The force kernel's intermediates: the flux form's resultants and tractions, or the energy
+  // form's nine-node gradients, whichever is larger.
+  const double kernel = std::max(sizeof(NodeResultants) + 2 * sizeof(Vec3),
+                                 sizeof(CosseratEnergy::StencilGradient));
+  const double per_node = kernel + 10 * sizeof(Vec3);
   const double output_buffer = 3.0 * sizeof(double) * owned_nodes;
   // 3 rows of 75 entries per node, the colouring's index of every entry, PETSc's vectors:
   // measured 13 KB per node (peak RSS 578 MB against Verlet's 59 MB on 200 x 200).
@@ -86,10 +90,12 @@ Diagnostics Simulation::diagnostics() {
   const double nodes = static_cast<double>(b.m) * b.n;
   Diagnostics d;
   d.area_ratio = dynamics_.total_area(r) / dynamics_.rest_area();
-  d.kinetic_energy = 0.5 * (scene_->material.mass / nodes) * global_sum(s2, b.comm);
+  d.kinetic_energy = 0.5 * dynamics_.node_mass() * global_sum(s2, b.comm);
   d.max_speed = std::sqrt(global_max(max2, b.comm));
-  d.center_of_mass = Vec3{global_sum(sum.x, b.comm), global_sum(sum.y, b.comm),
-                          global_sum(sum.z, b.comm)} / nodes;
+  const Vec3 position_total{global_sum(sum.x, b.comm), global_sum(sum.y, b.comm),
+                            global_sum(sum.z, b.comm)};
+  d.center_of_mass = position_total / nodes;
+  d.gravitational_energy = -dynamics_.node_mass() * dot(scene_->gravity, position_total);
   return d;
 }
 

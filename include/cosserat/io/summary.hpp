@@ -34,7 +34,10 @@ struct RunSummary {
   std::optional<long> unstable_step;
   double area_ratio = 0.0;  // S / S0 at the end
   double max_speed = 0.0;
+  std::string discretisation;  // "flux" or "energy"
   double kinetic_energy = 0.0;
+  double elastic_energy = 0.0;        // E of MODEL.md §2.5 (for the flux form too)
+  double gravitational_energy = 0.0;  // −Σ m g·r
   Vec3 center_of_mass;
   std::string output;  // the HDF5 file written
   std::optional<LinearSolveStats> linear_solves;  // semi-implicit only

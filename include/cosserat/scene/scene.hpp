@@ -84,7 +84,8 @@ struct Scene {
   Material material;
 
   // [model]
-  Borders borders = Borders::symmetric;
+  Discretisation discretisation = Discretisation::flux;
+  Borders borders = Borders::symmetric;  // flux form only
 
   // [environment]
   Vec3 gravity;

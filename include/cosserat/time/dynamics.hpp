@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/model/cosserat_energy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "cosserat/scene/scene.hpp"
 
@@ -38,6 +39,14 @@ class Dynamics {
                     Field<Vec3>* normals);
 
   bool has_fluid() const { return fluid_.has_value(); }
+  // The stored energy E of MODEL.md §2.5 (J), a global sum; reads the ghosts of r. For the
+  // flux form too, whose force is not its gradient: there it shows what the discretisation
+  // does to the energy.
+  double elastic_energy(const Field<Vec3>& r);
+  // The mass a node carries (kg): μ0 h1 h2 in the energy form (MODEL.md §2.5), M/(m n) in the
+  // flux form's diagnostics.
+  double node_mass() const { return node_mass_; }
+
   bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
   double rest_area() const { return rest_area_; }
   // S, a global reduction, the same bitwise for any decomposition; reads the ghosts of r.
@@ -51,11 +60,14 @@ class Dynamics {
   };
 
   const Block* block_;
-  CosseratModel model_;
+  Discretisation discretisation_;
+  std::optional<CosseratModel> flux_;
+  CosseratEnergy energy_;  // the force of the energy form; the energy of either
   double h1h2_;
   double area_quantum_;
   double mass_;
   double rest_area_;
+  double node_mass_;
   Vec3 gravity_;
   double damping_;
   std::optional<Fluid> fluid_;

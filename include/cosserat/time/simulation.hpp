@@ -19,9 +19,10 @@ namespace cosserat {
 // Whole-sheet quantities reported in the run summary; all global reductions.
 struct Diagnostics {
   double area_ratio = 0.0;      // S / S0
-  double kinetic_energy = 0.0;  // ½ Σ (M/(m n)) |v|²: the mass shared equally by the nodes
+  double kinetic_energy = 0.0;        // ½ Σ m |v|², m = Dynamics::node_mass()
+  double gravitational_energy = 0.0;  // −Σ m g·r
   double max_speed = 0.0;
-  Vec3 center_of_mass;          // mean node position
+  Vec3 center_of_mass;                // mean node position
 };
 
 class Simulation {
@@ -54,6 +55,9 @@ class Simulation {
   Stepper& stepper() { return stepper_; }
 
   Diagnostics diagnostics();
+  // The stored energy of MODEL.md §2.5 at the current positions (J); a global sum that costs
+  // about one force evaluation, so not part of diagnostics().
+  double elastic_energy() { return dynamics_.elastic_energy(stepper_.positions()); }
 
  private:
   static Field<Vec3> rest_positions(const Scene& scene, const Block& block);
