@@ -12,6 +12,7 @@
 
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/halo.hpp"
+#include "cosserat/model/cosserat_energy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "mpi_support.hpp"
 #include "support/sheets.hpp"
@@ -55,9 +56,14 @@ Evaluation evaluate(const Scene& scene, const Decomposition& d, MPI_Comm comm) {
   for (int l = block.l0; l < block.l1; ++l)
     for (int k = block.k0; k < block.k1; ++k) r(k, l) = deformed(scene, k, l);
   halo.exchange(r);
-  CosseratModel model(block, scene.h1(), scene.h2(),
-                      flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
-  model.internal_force(r, f);
+  const RestState rest = flat_rest_state(scene.material, scene.u, scene.v);
+  if (scene.discretisation == Discretisation::energy) {
+    CosseratEnergy energy(block, scene.h1(), scene.h2(), rest);
+    energy.internal_force(r, f);
+  } else {
+    CosseratModel model(block, scene.h1(), scene.h2(), rest, scene.borders);
+    model.internal_force(r, f);
+  }
   const double area = block_area(r, std::ldexp(scene.h1() * scene.h2(), -40)).global_total(comm);
   return {std::move(owned), std::move(f), area};
 }
@@ -66,7 +72,10 @@ TEST(DecompositionInvariance, ForcesOfOneEvaluationMatchOneBlockNodeByNode) {
   Scene odd = testing::odd_grid_scene(Integrator::verlet);
   Scene published = odd;
   published.borders = Borders::published;
-  for (const Scene& scene : {s2_cape(1), odd, published}) {
+  Scene energy = odd;
+  energy.discretisation = Discretisation::energy;
+  energy.title = "odd grid, energy form";
+  for (const Scene& scene : {s2_cape(1), odd, published, energy}) {
     const Evaluation reference =
         evaluate(scene, Decomposition::with_parts(scene.m, scene.n, 1, 1), MPI_COMM_SELF);
     for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
@@ -106,6 +115,25 @@ TEST(DecompositionInvariance, EveryIntegratorFollowsTheOneBlockTrajectory) {
       Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
       const bool stable = testing::advance(sim, scene.steps);
       ASSERT_TRUE(stable);
+      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+          << integrator_name(integrator) << ", split " << split_name(d);
+      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+          << integrator_name(integrator) << ", split " << split_name(d);
+    }
+  }
+}
+
+// The energy form gathers each node's force from its neighbours' gradients in a fixed order:
+// the same trajectory bitwise on every split, for a scheme of each state kind.
+TEST(DecompositionInvariance, EnergyFormFollowsTheOneBlockTrajectory) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
+    Scene scene = testing::odd_grid_scene(integrator);
+    scene.discretisation = Discretisation::energy;
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+    ASSERT_TRUE(testing::advance(reference, scene.steps));
+    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+      ASSERT_TRUE(testing::advance(sim, scene.steps));
       EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
           << integrator_name(integrator) << ", split " << split_name(d);
       EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
