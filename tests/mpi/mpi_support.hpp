@@ -93,7 +93,7 @@ end = 50
 // far below 1e-9 m.
 inline Scene semi_implicit_odd_grid_scene() {
   Scene scene = odd_grid_scene(Integrator::semi_implicit);
-  scene.dt = 2.0 * cfl_estimate(scene).dt;
+  scene.dt = 2.0 * cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2()).dt;
   scene.steps = 40;
   scene.solver.rtol = 1e-12;
   return scene;
