@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The README's two commands, for a fresh Debian 12 machine (as root, or with sudo):
 #   bash quickstart.sh demo   install what is missing, build, run S1, render s1_clothesline.png
-#   bash quickstart.sh test   install what is missing, build, run every test
+#   bash quickstart.sh test   install what is missing, build, run every test; then the debug
+#                             build (assertions, bounds and halo checks, FPE traps) runs the
+#                             unit and mpi tests again
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -32,6 +34,13 @@ build() {
   cmake --build --preset release -j "$(nproc)"
 }
 
+# The debug preset (-O1 -g, assertions, _GLIBCXX_ASSERTIONS, the halo's message-size checks,
+# floating-point traps), only what the unit and mpi tests need.
+build_debug() {
+  cmake --preset debug >/dev/null
+  cmake --build --preset debug -j "$(nproc)" --target unit_tests mpi_tests
+}
+
 # Open MPI refuses to start as root unless told; everything here runs as root.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
@@ -48,6 +57,8 @@ case "${1:-}" in
     install_missing
     build
     ctest --preset release -j "$(nproc)"
+    build_debug
+    ctest --preset debug -j "$(nproc)" -L '^(unit|mpi)$'
     ;;
   *)
     echo "usage: bash quickstart.sh demo|test" >&2

@@ -2,7 +2,6 @@
 
 #include "cosserat/grid/block.hpp"
 
-#include <cmath>
 #include <cstring>
 #include <limits>
 #include <vector>

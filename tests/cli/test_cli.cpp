@@ -275,8 +275,8 @@ TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
 // More ranks than a 3 x 6 grid can be split over (every block must be two nodes wide).
 TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
-  const std::string command = std::string(COSSERAT_MPIEXEC) +
-                              " -n 4 --oversubscribe --allow-run-as-root " + COSSERAT_EXE +
+  const std::string command = std::string(COSSERAT_MPIEXEC) + " -n 4 " +
+                              COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE +
                               " run " + scene + " --set grid.nodes=[3,6] -o " + path("x.h5") +
                               " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");

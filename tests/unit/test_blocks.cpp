@@ -22,9 +22,15 @@ Vec3 deformed(const Scene& s, int k, int l) {
           0.97 * z + 0.05 * std::cos(x)};
 }
 
-// Forces on a block whose ghosts are filled `rings` deep (the rest left at zero).
+// Forces on a block whose ghosts are filled `rings` deep; the ghosts further out hold the
+// flat sheet, wrong but not degenerate (left at zero they would coincide, and the unit normal
+// of a corner triangle of zero area is 0/0, which the debug build's FPE traps stop at).
 Field<Vec3> forces_on(const Block& block, const Scene& scene, int rings = kGhostWidth) {
   Field<Vec3> r(block), f(block);
+  const int g = block.ghost;
+  for (int l = std::max(block.l0 - g, 0); l < std::min(block.l1 + g, block.n); ++l)
+    for (int k = std::max(block.k0 - g, 0); k < std::min(block.k1 + g, block.m); ++k)
+      r(k, l) = Vec3{k * scene.h1(), 0.0, l * scene.h2()};
   for (int l = std::max(block.l0 - rings, 0); l < std::min(block.l1 + rings, block.n); ++l)
     for (int k = std::max(block.k0 - rings, 0); k < std::min(block.k1 + rings, block.m); ++k)
       r(k, l) = deformed(scene, k, l);
