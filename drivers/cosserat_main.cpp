@@ -8,8 +8,6 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
-#include <iostream>
-#include <sstream>
 #include <filesystem>
 #include <fmt/core.h>
 #include <memory>

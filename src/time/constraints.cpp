@@ -1,6 +1,5 @@
 #include "cosserat/time/constraints.hpp"
 
-#include <algorithm>
 #include <map>
 
 namespace cosserat {

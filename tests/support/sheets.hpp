@@ -3,7 +3,6 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <string>
 #include <vector>
 
@@ -35,13 +34,6 @@ inline Scene flat_sheet(int m, int n) {
 inline Fix fix_nodes(std::vector<NodeIndex> nodes) {
   Fix f;
   f.nodes.nodes = std::move(nodes);
-  return f;
-}
-
-// Every node of column k (all l).
-inline Fix fix_column(int k, int n) {
-  Fix f;
-  for (int l = 0; l < n; ++l) f.nodes.nodes.push_back({k, l});
   return f;
 }
 

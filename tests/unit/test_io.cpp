@@ -268,10 +268,11 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
   }
   const std::vector<std::string> expected{
       "scene",         "grid",          "ranks",          "threads",       "split",
-      "integrator",    "dt",            "steps",          "sim_time",
+      "integrator",    "discretisation", "dt",          "steps",          "sim_time",
       "wall_seconds",  "node_steps_per_second",           "halo_seconds",
       "restarted_from", "status",
       "unstable_step", "area_ratio",    "max_speed",      "kinetic_energy",
+      "elastic_energy", "gravitational_energy",
       "center_of_mass", "output",        "linear_solves",  "rest"};
   EXPECT_EQ(keys, expected);
   EXPECT_NE(json.find(R"("linear_solves": null,)"), std::string::npos) << json;

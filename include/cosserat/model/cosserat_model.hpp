@@ -1,7 +1,6 @@
 #pragma once
 // Internal force of the elastic Cosserat surface (MODEL.md §1–§2) on a local block.
 
-#include <vector>
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/reduce.hpp"

@@ -1,7 +1,6 @@
 #pragma once
 // Fixed nodes with axis masks and step windows (MODEL.md §4.1), for the nodes this block owns.
 
-#include <array>
 #include <cstdint>
 #include <vector>
 

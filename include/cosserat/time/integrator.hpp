@@ -4,11 +4,9 @@
 // of names and an enum is vocabulary, not code to link.
 
 #include <algorithm>
-#include <array>
 #include <cstddef>
 #include <optional>
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace cosserat {

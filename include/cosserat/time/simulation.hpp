@@ -5,7 +5,6 @@
 #include <mpi.h>
 
 #include <optional>
-#include <vector>
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
