@@ -34,8 +34,8 @@ if [[ $# -lt 2 || $# -gt 3 ]]; then
   echo "usage: $0 OLD_BUILD_DIR NEW_BUILD_DIR [WORK_DIR]" >&2
   exit 2
 fi
-old_exe=$1/cosserat
-new_exe=$2/cosserat
+old_exe=$(realpath -m "$1")/cosserat
+new_exe=$(realpath -m "$2")/cosserat
 for exe in "$old_exe" "$new_exe"; do
   if [[ ! -x $exe ]]; then
     echo "$0: no executable $exe" >&2
