@@ -125,9 +125,10 @@ std::string default_output(const cosserat::Scene& scene) { return scene.name + "
 
 std::string describe(const cosserat::Instability& failure) {
   if (failure.solver_failure) return *failure.solver_failure;
-  return fmt::format("node [{}, {}] {}", failure.k, failure.l,
+  return fmt::format("node [{}, {}] {}; {}", failure.k, failure.l,
                      failure.not_finite ? "has a non-finite position"
-                                        : "moved more than half a grid spacing in one step");
+                                        : "moved more than half a grid spacing in one step",
+                     failure.diagnosis);
 }
 
 // Memory of every rank on this node, against the node's physical memory.

@@ -16,7 +16,11 @@ StableDtRow stable_dt_row(const std::string& integrator, StableStep found, doubl
     if (!t.stable && t.dt == found.unstable_dt) row.cause = t.cause;
   }
   if (found.unstable_dt == 0.0) row.cause = fmt::format("stable up to dt = T = {} s", duration);
-  if (found.stable_dt == 0.0)
+  if (found.fails_near_time)
+    row.cause = fmt::format(
+        "fails near t = {:.3g} s for every step tried (the model's failure, not the step's); {}",
+        *found.fails_near_time, row.cause);
+  else if (found.stable_dt == 0.0)
     row.cause = "no stable step down to 1e-6 of the scene's dt; " + row.cause;
   row.found = std::move(found);
   return row;

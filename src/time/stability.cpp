@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "cosserat/time/simulation.hpp"
 
@@ -25,8 +27,9 @@ StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Com
       trial.cause =
           failure->solver_failure
               ? fmt::format("step {}: {}", failure->step, *failure->solver_failure)
-              : fmt::format("step {}: node [{}, {}] {}", failure->step, failure->k, failure->l,
-                            failure->not_finite ? "not finite" : "moved > h/2");
+              : fmt::format("step {}: node [{}, {}] {}; {}", failure->step, failure->k,
+                            failure->l, failure->not_finite ? "not finite" : "moved > h/2",
+                            failure->diagnosis);
       break;
     }
   }
@@ -59,13 +62,29 @@ StableStep largest_stable_step(const Scene& scene, double duration, double toler
     }
   } else {
     result.unstable_dt = dt;
+    // When the run fails at the same simulated time whatever the step, halving is hopeless.
+    auto failure_time = [&] {
+      const StabilityTrial& t = result.trials.back();
+      return static_cast<double>(t.steps + 1) * t.dt;
+    };
+    std::vector<double> failure_times{failure_time()};
     while (result.stable_dt == 0.0) {
       dt *= 0.5;
       if (dt < floor) return result;
-      if (trial(dt))
+      if (trial(dt)) {
         result.stable_dt = dt;
-      else
-        result.unstable_dt = dt;
+        break;
+      }
+      result.unstable_dt = dt;
+      failure_times.push_back(failure_time());
+      if (failure_times.size() >= 3) {
+        const auto last = failure_times.end() - 3;
+        const auto [low, high] = std::minmax_element(last, failure_times.end());
+        if (*high - *low <= 0.05 * *high) {
+          result.fails_near_time = failure_times.back();
+          return result;
+        }
+      }
     }
   }
   while (result.unstable_dt - result.stable_dt > tolerance * result.stable_dt) {

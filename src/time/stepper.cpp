@@ -1,5 +1,7 @@
 #include "cosserat/time/stepper.hpp"
 
+#include "cosserat/time/failure_diagnosis.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -13,6 +15,8 @@ Stepper::Stepper(const Scene& scene, const Decomposition& decomposition, const B
     : block_(&block),
       constraints_(scene.fixes, block),
       dt_(scene.dt),
+      h1_(scene.h1()),
+      h2_(scene.h2()),
       max_move_(0.5 * std::min(scene.h1(), scene.h2())) {
   const StepContext context{block, halo, dynamics, constraints_, scene.dt};
   scheme_ = make(SchemeSetup{scene, decomposition, context, positions});
@@ -23,7 +27,7 @@ std::optional<Instability> Stepper::step() {
   constraints_.begin_step(step_, scheme_->positions());
   if (auto solver_failure = scheme_->advance(step_)) {
     return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, -1, -1, false,
-                       std::move(solver_failure)};
+                       std::move(solver_failure), {}};
   }
   if (!actions_.empty()) {
     ProposedStep proposed{step_ + 1, dt_, scheme_->positions(), scheme_->next_positions(),
@@ -75,8 +79,9 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next) const {
   int reason = global == local && local_not_finite ? 1 : 0;
   int any_reason = reason;
   MPI_Allreduce(&reason, &any_reason, 1, MPI_INT, MPI_MAX, b.comm);
-  return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, static_cast<int>(global % b.m),
-                     static_cast<int>(global / b.m), any_reason != 0, std::nullopt};
+  const int k = static_cast<int>(global % b.m), l = static_cast<int>(global / b.m);
+  return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, k, l, any_reason != 0,
+                     std::nullopt, diagnose_failure(r, k, l, h1_, h2_)};
 }
 
 void Stepper::resume(long step) {

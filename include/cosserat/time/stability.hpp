@@ -6,6 +6,7 @@
 #include <mpi.h>
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -30,13 +31,17 @@ StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Com
 struct StableStep {
   double stable_dt = 0.0;    // the largest step found stable (0: none, down to the floor)
   double unstable_dt = 0.0;  // the smallest found unstable (0: none, up to the ceiling)
+  // Set when halving the step stopped changing when the run fails: the failure is the
+  // semi-discrete system's, not the integrator's, and no step will cure it.
+  std::optional<double> fails_near_time;
   std::vector<StabilityTrial> trials;
 };
 
 // Starting from the scene's dt, doubles or halves until stable and unstable
 // steps bracket the limit, then bisects until they are within `tolerance` of
 // each other (relative to the stable one). Steps above `duration` or below 1e-6
-// of the scene's dt end the search unbracketed. `report` sees every trial as it
+// of the scene's dt end the search unbracketed, and so do three halvings in a row whose
+// runs all fail within 5 % of the same simulated time. `report` sees every trial as it
 // ends (rank 0 prints progress with it).
 StableStep largest_stable_step(const Scene& scene, double duration, double tolerance, MPI_Comm comm,
                                const SchemeFactory& make,

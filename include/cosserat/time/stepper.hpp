@@ -25,6 +25,7 @@ struct Instability {
   int k, l;
   bool not_finite;  // else: moved more than half a grid spacing
   std::optional<std::string> solver_failure;
+  std::string diagnosis;  // what the last good state looks like near node (k, l)
 };
 
 // The state a step proposes, before the stability check accepts it.
@@ -87,6 +88,7 @@ class Stepper {
   const Block* block_;
   Constraints constraints_;
   double dt_;
+  double h1_, h2_;
   double max_move_;  // half the smaller grid spacing (MODEL.md §4.2)
   long step_ = 0;
   double time_ = 0.0;
