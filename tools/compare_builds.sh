@@ -16,9 +16,11 @@
 #   - the .xmf files are equal (cmp); both runs write the same file name in their own folder;
 #   - the .h5 files are equal byte for byte (cmp), EXCEPT the four seconds bytes of each HDF5
 #     "object modification time" message (header message type 0x0012, one per dataset:
-#     /positions, /time, /step). HDF5 stamps every dataset with the wall-clock second it was
-#     last written (H5Pset_obj_track_times is on by default and src/io does not turn it off),
-#     so two runs of the SAME binary a second apart already differ there, and nowhere else.
+#     /positions, /time, /step). Builds before 2026-11-27 stamp every dataset with the
+#     wall-clock second it was last written (HDF5's default), so two runs of the SAME such
+#     binary a second apart differ there and nowhere else; later builds turn the stamps off
+#     (src/io/frame_writer.cpp), which also moves the header bytes: between a stamped and an
+#     unstamped build only the dataset check below can say "same numbers".
 #     Those bytes are masked in both files, only where both files have such a message at the
 #     same offset; every other byte (superblock, object headers, the attributes scene /
 #     integrator / version / overrides, chunk indexes, all raw data) must match;
