@@ -253,6 +253,15 @@ int run(const RunOptions& options, int rank, int ranks) {
                  "(step {}) is the last frame of {}\n",
                  failure->step, failure->time, describe(*failure), simulation.step_index(),
                  output);
+    if (rank == 0 && !failure->solver_failure) {
+      const CflEstimate cfl =
+          cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
+      fmt::print(stderr,
+                 "hint: this run's dt is {} s; the rest sheet's CFL estimate is {:.3g} s "
+                 "(docs/stability.md); `cosserat stable-dt {}` measures the largest stable "
+                 "step, and says when no step helps\n",
+                 scene.dt, cfl.dt, options.scene_path);
+    }
     writer->set_attribute("status", fmt::format("unstable at step {}", failure->step));
   } else {
     writer->set_attribute("status", "ok");

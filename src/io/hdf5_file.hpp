@@ -12,7 +12,7 @@
 #include <utility>
 
 #include "cosserat/grid/block.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat::hdf5 {
 

@@ -5,7 +5,7 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/model/material.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat::geometry {
 

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "cosserat/model/material.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat::scene_detail {
 

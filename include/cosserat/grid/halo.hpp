@@ -13,7 +13,7 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat {
 

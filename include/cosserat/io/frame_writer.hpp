@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat {
 

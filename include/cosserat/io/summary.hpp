@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/linear_solve_stats.hpp"
 #include "cosserat/time/simulation.hpp"

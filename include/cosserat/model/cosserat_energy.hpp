@@ -6,7 +6,7 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/model/cosserat_model.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat {
 

@@ -6,7 +6,7 @@
 #include "cosserat/grid/reduce.hpp"
 #include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 
 namespace cosserat {
 

@@ -11,7 +11,7 @@
 
 #include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
-#include "cosserat/model/vec3.hpp"
+#include "cosserat/grid/vec3.hpp"
 #include "cosserat/time/integrator.hpp"
 
 namespace cosserat {
