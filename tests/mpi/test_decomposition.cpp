@@ -33,13 +33,6 @@ Scene s2_cape(long steps) {
                     {"time.steps=" + std::to_string(steps)});
 }
 
-// A strongly deformed sheet: stretched, bent and twisted.
-Vec3 deformed(const Scene& s, int k, int l) {
-  const double x = k * s.h1(), z = l * s.h2();
-  return {1.05 * x + 0.1 * std::sin(z), 0.8 * std::sin(0.4 * x) * std::cos(0.3 * z) + 0.02 * x * z,
-          0.97 * z + 0.05 * std::cos(x)};
-}
-
 // The internal force of one evaluation on a block whose owned nodes alone are set: the ghosts
 // come from the halo exchange or not at all. Also the total area, through the same ghosts.
 struct Evaluation {
@@ -55,7 +48,7 @@ Evaluation evaluate(const Scene& scene, const Decomposition& d, MPI_Comm comm) {
   Halo halo(d, block, rank);
   Field<Vec3> r(block), f(block);
   for (int l = block.l0; l < block.l1; ++l)
-    for (int k = block.k0; k < block.k1; ++k) r(k, l) = deformed(scene, k, l);
+    for (int k = block.k0; k < block.k1; ++k) r(k, l) = testing::deformed(scene, k, l);
   halo.exchange(r);
   const RestState rest = flat_rest_state(scene.material, scene.u, scene.v);
   if (scene.discretisation == Discretisation::energy) {
@@ -105,7 +98,7 @@ TEST(DecompositionInvariance, WithoutTheHaloTheBorderForcesDiffer) {
     for (int k = std::max(block.k0 - g, 0); k < std::min(block.k1 + g, block.m); ++k)
       r(k, l) = Vec3{k * scene.h1(), 0.0, l * scene.h2()};
   for (int l = block.l0; l < block.l1; ++l)
-    for (int k = block.k0; k < block.k1; ++k) r(k, l) = deformed(scene, k, l);
+    for (int k = block.k0; k < block.k1; ++k) r(k, l) = testing::deformed(scene, k, l);
   CosseratModel model(block, scene.h1(), scene.h2(),
                       flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
   model.internal_force(r, f);

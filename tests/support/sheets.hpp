@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,26 @@ inline Fix fix_nodes(std::vector<NodeIndex> nodes) {
   Fix f;
   f.nodes.nodes = std::move(nodes);
   return f;
+}
+
+// A smoothly but strongly deformed sheet: stretched, bent and twisted, well away from rest.
+inline Vec3 deformed(const Scene& s, int k, int l) {
+  const double x = k * s.h1(), z = l * s.h2();
+  return {1.05 * x + 0.1 * std::sin(z), 0.8 * std::sin(0.4 * x) * std::cos(0.3 * z) + 0.02 * x * z,
+          0.97 * z + 0.05 * std::cos(x)};
+}
+
+// Every scheme of the build: the semi-implicit one exists only with PETSc.
+inline std::vector<Integrator> every_scheme() {
+  std::vector<Integrator> schemes;
+  for (const std::string& name : integrator_names()) {
+    const Integrator scheme = *integrator_from_name(name);
+#if !defined(COSSERAT_HAVE_PETSC)
+    if (scheme == Integrator::semi_implicit) continue;
+#endif
+    schemes.push_back(scheme);
+  }
+  return schemes;
 }
 
 // GoogleTest parameter name of a scheme: its scene name with '_' for '-'.

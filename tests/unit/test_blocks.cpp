@@ -15,13 +15,6 @@
 namespace cosserat {
 namespace {
 
-// A smoothly but strongly deformed sheet: stretched, bent and twisted.
-Vec3 deformed(const Scene& s, int k, int l) {
-  const double x = k * s.h1(), z = l * s.h2();
-  return {1.05 * x + 0.1 * std::sin(z), 0.8 * std::sin(0.4 * x) * std::cos(0.3 * z) + 0.02 * x * z,
-          0.97 * z + 0.05 * std::cos(x)};
-}
-
 // Forces on a block whose ghosts are filled `rings` deep; the ghosts further out hold the
 // flat sheet, wrong but not degenerate (left at zero they would coincide, and the unit normal
 // of a corner triangle of zero area is 0/0, which the debug build's FPE traps stop at).
@@ -33,7 +26,7 @@ Field<Vec3> forces_on(const Block& block, const Scene& scene, int rings = kGhost
       r(k, l) = Vec3{k * scene.h1(), 0.0, l * scene.h2()};
   for (int l = std::max(block.l0 - rings, 0); l < std::min(block.l1 + rings, block.n); ++l)
     for (int k = std::max(block.k0 - rings, 0); k < std::min(block.k1 + rings, block.m); ++k)
-      r(k, l) = deformed(scene, k, l);
+      r(k, l) = testing::deformed(scene, k, l);
   CosseratModel model(block, scene.h1(), scene.h2(),
                       flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
   model.internal_force(r, f);

@@ -14,13 +14,6 @@
 namespace cosserat {
 namespace {
 
-// A sheet stretched, bent and twisted well away from rest, with cells of every aspect.
-Vec3 deformed(const Scene& s, int k, int l) {
-  const double x = k * s.h1(), z = l * s.h2();
-  return {1.05 * x + 0.1 * std::sin(z), 0.8 * std::sin(0.4 * x) * std::cos(0.3 * z) + 0.02 * x * z,
-          0.97 * z + 0.05 * std::cos(x)};
-}
-
 struct Sheet {
   Scene scene;
   Block block;
@@ -33,7 +26,7 @@ struct Sheet {
         r(block),
         energy(block, s.h1(), s.h2(), flat_rest_state(s.material, s.u, s.v)) {
     for (int l = 0; l < s.n; ++l)
-      for (int k = 0; k < s.m; ++k) r(k, l) = deformed(s, k, l);
+      for (int k = 0; k < s.m; ++k) r(k, l) = testing::deformed(s, k, l);
   }
   double total() const { return energy.block_energy(r); }
 };

@@ -101,20 +101,8 @@ TEST_P(EveryScheme, ConvergenceOrder) {
   EXPECT_NEAR(observed, order, 0.3);
 }
 
-// Every scheme of the build: the semi-implicit one exists only with PETSc.
-std::vector<Integrator> every_scheme() {
-  std::vector<Integrator> schemes;
-  for (const std::string& name : integrator_names()) {
-    const Integrator scheme = *integrator_from_name(name);
-#if !defined(COSSERAT_HAVE_PETSC)
-    if (scheme == Integrator::semi_implicit) continue;
-#endif
-    schemes.push_back(scheme);
-  }
-  return schemes;
-}
-
-INSTANTIATE_TEST_SUITE_P(Integrators, EveryScheme, ::testing::ValuesIn(every_scheme()),
+INSTANTIATE_TEST_SUITE_P(Integrators, EveryScheme,
+                         ::testing::ValuesIn(testing::every_scheme()),
                          testing::scheme_test_name);
 
 }  // namespace

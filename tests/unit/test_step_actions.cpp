@@ -89,19 +89,8 @@ TEST_P(EverySchemeWithAnAction, RunsBeforeTheStabilityCheck) {
   EXPECT_EQ(sim.step_index(), 2);
 }
 
-std::vector<Integrator> every_scheme() {
-  std::vector<Integrator> schemes;
-  for (const std::string& name : integrator_names()) {
-    const Integrator scheme = *integrator_from_name(name);
-#if !defined(COSSERAT_HAVE_PETSC)
-    if (scheme == Integrator::semi_implicit) continue;
-#endif
-    schemes.push_back(scheme);
-  }
-  return schemes;
-}
-
-INSTANTIATE_TEST_SUITE_P(Schemes, EverySchemeWithAnAction, ::testing::ValuesIn(every_scheme()),
+INSTANTIATE_TEST_SUITE_P(Schemes, EverySchemeWithAnAction,
+                         ::testing::ValuesIn(testing::every_scheme()),
                          testing::scheme_test_name);
 
 }  // namespace
