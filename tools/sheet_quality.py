@@ -1,0 +1,202 @@
+#!/usr/bin/env python3
+"""Quality of a sheet's shape in the frames of a run (issue 11, item 5).
+
+    /usr/bin/python3 tools/sheet_quality.py OUT.h5 [--json] [--every N]
+
+Per frame, from /positions [frames, m, n, 3] (node [k, l] at [f, k, l, :], docs/output.md):
+
+  det ratio   smallest det a / det A over the cells: cell [k, l] has the edge vectors
+              e1 = r[k+1, l] - r[k, l], e2 = r[k, l+1] - r[k, l]; a = |e1|^2 |e2|^2 - (e1.e2)^2,
+              A the same of frame 0 (the rest state). 0 = a cell collapsed to a line.
+  signed      the same with the sign of n . n_nb, n the cell's unit normal e1 x e2 and n_nb the
+              sum of the unit normals of its edge neighbours: negative = a cell inverted against
+              the cells around it (the sheet turned through itself there).
+  min cos     smallest cosine between the unit normals of two edge-adjacent cells: 1 flat,
+              0 a right-angle crease, -1 folded fully over.
+  close pairs node pairs more than 3 indices apart (Chebyshev distance in (k, l) > 3) whose
+              distance is below h/2, h the smallest rest spacing (from frame 0); and the
+              smallest distance / h of such far-apart pairs within h (none within h: blank).
+              Found with a uniform grid of bins of size h (numpy), so a 120 x 120 sheet over a
+              hundred frames takes seconds.
+  area ratio  S / S0, S the sum over cells of the two triangles (k,l)(k+1,l)(k,l+1) and
+              (k+1,l+1)(k,l+1)(k+1,l).
+
+Prints a table (one line per frame, then the extremes over the run); --json prints one JSON
+object {"file", "grid", "h", "frames": [...], "overall": {...}} instead.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+
+os.environ.setdefault("HDF5_USE_FILE_LOCKING", "FALSE")
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
+
+FAR = 3  # pairs closer than this many indices (Chebyshev) are neighbours on the sheet
+
+
+def cell_vectors(r):
+    e1 = r[1:, :-1] - r[:-1, :-1]
+    e2 = r[:-1, 1:] - r[:-1, :-1]
+    return e1, e2
+
+
+def det_metric(e1, e2):
+    a11 = np.einsum("...i,...i", e1, e1)
+    a22 = np.einsum("...i,...i", e2, e2)
+    a12 = np.einsum("...i,...i", e1, e2)
+    return a11 * a22 - a12 * a12
+
+
+def area(r):
+    p00, p10, p01, p11 = r[:-1, :-1], r[1:, :-1], r[:-1, 1:], r[1:, 1:]
+    t1 = np.linalg.norm(np.cross(p10 - p00, p01 - p00), axis=-1)
+    t2 = np.linalg.norm(np.cross(p01 - p11, p10 - p11), axis=-1)
+    return 0.5 * float(t1.sum() + t2.sum())
+
+
+def unit_normals(e1, e2):
+    n = np.cross(e1, e2)
+    norm = np.linalg.norm(n, axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(norm > 0, n / np.where(norm > 0, norm, 1), 0.0)
+
+
+def proximity(r, h):
+    """Pairs (i < j) with Chebyshev index distance > FAR closer than h: (count below h/2,
+    smallest distance / h or None)."""
+    m, n, _ = r.shape
+    pts = r.reshape(-1, 3)
+    kk, ll = np.divmod(np.arange(m * n), n)
+    cell = np.floor((pts - pts.min(axis=0)) / h).astype(np.int64)
+    dims = cell.max(axis=0) + 3
+    key = ((cell[:, 0] + 1) * dims[1] + (cell[:, 1] + 1)) * dims[2] + (cell[:, 2] + 1)
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    count, best = 0, math.inf
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dz in (-1, 0, 1):
+                target = key + (dx * dims[1] + dy) * dims[2] + dz
+                lo = np.searchsorted(skey, target, "left")
+                hi = np.searchsorted(skey, target, "right")
+                sizes = hi - lo
+                total = int(sizes.sum())
+                if total == 0:
+                    continue
+                i = np.repeat(np.arange(pts.shape[0]), sizes)
+                start = np.repeat(lo - np.cumsum(sizes) + sizes, sizes)
+                j = order[np.arange(total) + start]
+                keep = (i < j) & (np.maximum(abs(kk[i] - kk[j]), abs(ll[i] - ll[j])) > FAR)
+                if not keep.any():
+                    continue
+                i, j = i[keep], j[keep]
+                d = np.linalg.norm(pts[i] - pts[j], axis=-1)
+                count += int((d < 0.5 * h).sum())
+                best = min(best, float(d.min()))
+    ratio = best / h if best < h else None
+    return count, ratio
+
+
+def analyse(path, every=1):
+    with h5py.File(path, "r") as f:
+        pos = f["/positions"]
+        times = f["/time"][:]
+        steps = f["/step"][:] if "/step" in f else np.arange(len(times))
+        frames = list(range(0, pos.shape[0], every))
+        if frames[-1] != pos.shape[0] - 1:
+            frames.append(pos.shape[0] - 1)
+        rest = pos[0]
+        e1, e2 = cell_vectors(rest)
+        det_rest = det_metric(e1, e2)
+        h = float(min(np.linalg.norm(e1, axis=-1).min(), np.linalg.norm(e2, axis=-1).min()))
+        area0 = area(rest)
+        out = []
+        for fi in frames:
+            r = pos[fi]
+            e1, e2 = cell_vectors(r)
+            ratio = det_metric(e1, e2) / det_rest
+            nrm = unit_normals(e1, e2)
+            nb = np.zeros_like(nrm)
+            nb[1:] += nrm[:-1]
+            nb[:-1] += nrm[1:]
+            nb[:, 1:] += nrm[:, :-1]
+            nb[:, :-1] += nrm[:, 1:]
+            sign = np.where(np.einsum("...i,...i", nrm, nb) < 0, -1.0, 1.0)
+            cos_k = np.einsum("...i,...i", nrm[1:], nrm[:-1])
+            cos_l = np.einsum("...i,...i", nrm[:, 1:], nrm[:, :-1])
+            min_cos = min(float(cos_k.min()) if cos_k.size else 1.0,
+                          float(cos_l.min()) if cos_l.size else 1.0)
+            finite = bool(np.isfinite(r).all())
+            pairs, dmin = proximity(r, h) if finite else (None, None)
+            out.append({
+                "frame": fi, "step": int(steps[fi]), "time": float(times[fi]),
+                "min_det_ratio": float(ratio.min()),
+                "min_signed_det_ratio": float((sign * ratio).min()),
+                "inverted_cells": int((sign < 0).sum()),
+                "min_normal_cos": min_cos,
+                "close_pairs": pairs, "min_far_distance_over_h": dmin,
+                "area_ratio": area(r) / area0,
+            })
+        status = f.attrs.get("status", "")
+        if isinstance(status, bytes):
+            status = status.decode()
+
+    def extreme(key, fn):
+        vals = [(fr[key], fr["time"]) for fr in out if fr[key] is not None]
+        if not vals:
+            return None, None
+        v, t = fn(vals, key=lambda x: x[0])
+        return v, t
+
+    overall = {"status": status, "frames": len(out)}
+    for key, fn in (("min_det_ratio", min), ("min_signed_det_ratio", min),
+                    ("inverted_cells", max), ("min_normal_cos", min), ("close_pairs", max),
+                    ("min_far_distance_over_h", min), ("area_ratio", min)):
+        v, t = extreme(key, fn)
+        overall[key] = v
+        overall[key + "_time"] = t
+    overall["max_area_ratio"] = max(fr["area_ratio"] for fr in out)
+    overall["final_area_ratio"] = out[-1]["area_ratio"]
+    return {"file": path, "grid": list(rest.shape[:2]), "h": h, "frames": out,
+            "overall": overall}
+
+
+def fmt(v, spec):
+    return "—" if v is None else format(v, spec)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("h5")
+    ap.add_argument("--json", action="store_true", help="print one JSON object")
+    ap.add_argument("--every", type=int, default=1, help="analyse every N-th frame (and the last)")
+    args = ap.parse_args()
+    res = analyse(args.h5, max(1, args.every))
+    if args.json:
+        json.dump(res, sys.stdout)
+        print()
+        return
+    print(f"{res['file']}: grid {res['grid'][0]} x {res['grid'][1]}, h = {res['h']:.4g} m, "
+          f"status {res['overall']['status'] or '?'}")
+    print(f"{'frame':>5} {'time':>8} {'det a/A':>9} {'signed':>9} {'inv':>4} {'min cos':>8} "
+          f"{'pairs<h/2':>9} {'dmin/h':>7} {'S/S0':>7}")
+    for fr in res["frames"]:
+        print(f"{fr['frame']:5d} {fr['time']:8.3f} {fr['min_det_ratio']:9.3g} "
+              f"{fr['min_signed_det_ratio']:9.3g} {fr['inverted_cells']:4d} "
+              f"{fr['min_normal_cos']:8.3f} {fmt(fr['close_pairs'], '9d')} "
+              f"{fmt(fr['min_far_distance_over_h'], '7.3f')} {fr['area_ratio']:7.4f}")
+    o = res["overall"]
+    print(f"overall: det a/A {o['min_det_ratio']:.3g} (t {o['min_det_ratio_time']:.3f}), signed "
+          f"{o['min_signed_det_ratio']:.3g}, most inverted cells {o['inverted_cells']}, min cos "
+          f"{o['min_normal_cos']:.3f} (t {o['min_normal_cos_time']:.3f}), most pairs<h/2 "
+          f"{fmt(o['close_pairs'], 'd')}, dmin/h {fmt(o['min_far_distance_over_h'], '.3f')}, "
+          f"S/S0 {o['area_ratio']:.4f}..{o['max_area_ratio']:.4f} (final "
+          f"{o['final_area_ratio']:.4f})")
+
+
+if __name__ == "__main__":
+    main()
