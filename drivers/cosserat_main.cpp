@@ -261,6 +261,11 @@ int run(const RunOptions& options, int rank, int ranks) {
                  "(docs/stability.md); `cosserat stable-dt {}` measures the largest stable "
                  "step, and says when no step helps\n",
                  scene.dt, cfl.dt, options.scene_path);
+      if (scene.energy_indefinite)
+        fmt::print(stderr,
+                   "hint: this material's stored energy is not positive definite (phi^2 >= 4 "
+                   "zeta xi, see the warning above): creases one cell wide can grow whatever "
+                   "the step; raise xi or lower phi\n");
     }
     writer->set_attribute("status", fmt::format("unstable at step {}", failure->step));
   } else {

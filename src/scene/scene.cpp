@@ -423,6 +423,7 @@ void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
     const double coupling = material.phi[i] * material.phi[i];
     const double bound = 4.0 * material.zeta[i] * material.xi[i];
     if (coupling >= bound) {
+      scene.energy_indefinite = true;
       scene.warnings.push_back(fmt::format(
           "{}: material component {}: phi^2 = {} >= 4 zeta xi = {}, so the stored energy is not "
           "positive definite (MODEL.md §1); raise xi or lower phi",

@@ -105,6 +105,9 @@ struct Scene {
 
   // Warnings the loader found (e.g. a coupling that breaks positive definiteness).
   std::vector<std::string> warnings;
+  // φ² ≥ 4ζξ in some component: the stored energy has directions that cost nothing or less
+  // (MODEL.md §1), so grid-scale creases may grow whatever the step.
+  bool energy_indefinite = false;
 
   double h1() const { return size1 / (m - 1); }
   double h2() const { return size2 / (n - 1); }
