@@ -155,7 +155,9 @@ void read_model(const Table& model, Scene& scene) {
     if (name == "symmetric") {
       scene.borders = Borders::symmetric;
     } else if (name == "published") {
+      // The published rules exist in the flux form alone, so asking for them asks for it.
       scene.borders = Borders::published;
+      scene.discretisation = Discretisation::flux;
     } else {
       borders->fail(fmt::format("unknown borders \"{}\"; allowed: symmetric, published", name));
     }

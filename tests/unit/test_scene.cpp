@@ -621,6 +621,29 @@ TEST(SceneError, UnknownModelAndBorders) {
               AllOf(HasSubstr("key 'model.borders'"), HasSubstr("allowed: symmetric, published")));
 }
 
+// The energy form is the default; the published border rules exist in the flux form alone, so
+// asking for them asks for it, and asking for both the energy form and them is refused.
+TEST(Scene, DiscretisationDefaultsToTheEnergyForm) {
+  SceneText text;
+  EXPECT_EQ(parse(text).discretisation, Discretisation::energy);
+  text.tail = "[model]\ndiscretisation = \"flux\"\n";
+  EXPECT_EQ(parse(text).discretisation, Discretisation::flux);
+  text.tail = "[model]\nborders = \"published\"\n";
+  EXPECT_EQ(parse(text).discretisation, Discretisation::flux);
+  EXPECT_EQ(parse(SceneText{}, {"model.discretisation=\"flux\""}).discretisation,
+            Discretisation::flux);
+}
+
+TEST(SceneError, UnknownDiscretisationAndEnergyWithPublishedBorders) {
+  SceneText text;
+  text.tail = "[model]\ndiscretisation = \"fem\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.discretisation'"),
+                                    HasSubstr("allowed: flux, energy")));
+  text.tail = "[model]\ndiscretisation = \"energy\"\nborders = \"published\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.discretisation'"),
+                                    HasSubstr("no published border rules")));
+}
+
 TEST(SceneError, NegativeDampingAndViscosity) {
   SceneText text;
   text.tail = "[environment]\ndamping = -0.2\n";

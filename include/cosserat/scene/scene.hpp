@@ -84,7 +84,7 @@ struct Scene {
   Material material;
 
   // [model]
-  Discretisation discretisation = Discretisation::flux;
+  Discretisation discretisation = Discretisation::energy;
   Borders borders = Borders::symmetric;  // flux form only
 
   // [environment]
