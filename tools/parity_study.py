@@ -83,11 +83,24 @@ class Study:
             return list(pool.map(self.stable_dt, jobs))
 
     # ------------------------------------------------------------------------------------------
-    def sheet(self, nodes, dt, steps, every):
-        """S1's sheet, material, environment and supports on a nodes x nodes grid: the corners
-        [0, 0] and [0, nodes-1] of the x1 = 0 edge, held throughout (S1's fix window, 20 001
-        steps, outlasts its run; here it has no end so that no dt releases it)."""
-        path = self.work / f"sheet-{nodes}-{dt!r}.toml"
+    def sheet(self, nodes, dt, steps, every, support):
+        """S1's sheet, material and environment on a nodes x nodes grid (nodes = 9 * 2^j + 1),
+        held throughout (S1's fix window, 20 001 steps, outlasts its run; here it has no end so
+        that no dt releases it) by
+          corners   S1's supports: the corner nodes [0, 0] and [0, nodes-1] of the x1 = 0 edge;
+          segments  the x1 = 0 edge from each of those corners to the next node of the 10 x 10
+                    grid (10/9 m at each end), the same support on every grid;
+        with "-undamped" appended, without S1's medium damping (the forms' damping differs by
+        the area ratio S/S0: the flux form's μ = M/S is the current one, the energy form's μ0
+        = M/S0 the rest one)."""
+        damping = 0.0 if support.endswith("-undamped") else 0.2
+        if support.startswith("corners"):
+            fix = f"[[fix]]\nnodes = [[0, 0], [0, {nodes - 1}]]\n"
+        else:
+            s = (nodes - 1) // 9
+            fix = (f"[[fix]]\nregion = {{ rect = [0, 0, 0, {s}] }}\n"
+                   f"[[fix]]\nregion = {{ rect = [0, {nodes - 1 - s}, 0, {nodes - 1}] }}\n")
+        path = self.work / f"sheet-{support}-{nodes}-{dt!r}.toml"
         path.write_text(f"""title = "S1-like sheet {nodes} x {nodes}"
 [grid]
 nodes = [{nodes}, {nodes}]
@@ -102,24 +115,22 @@ xi = 0.3
 phi = 0.001
 [environment]
 gravity = [0.0, -9.8, 0.0]
-damping = 0.2
+damping = {damping!r}
 [time]
 integrator = "verlet"
 dt = {dt!r}
 steps = {steps}
 output_every = {every}
-[[fix]]
-nodes = [[0, 0], [0, {nodes - 1}]]
-""")
+{fix}""")
         return str(path)
 
     def run(self, job):
         """One run of the sheet: (job, summary, {time: positions [m, n, 3]})."""
-        nodes, form, dt, duration, samples = job
+        support, nodes, form, dt, duration, samples = job
         steps = round(duration / dt)
         every = round(duration / samples / dt)
-        scene = self.sheet(nodes, dt, steps, every)
-        stem = self.work / f"run-{nodes}-{form}-{dt!r}"
+        scene = self.sheet(nodes, dt, steps, every, support)
+        stem = self.work / f"run-{support}-{nodes}-{form}-{dt!r}"
         command = [self.exe, "run", scene, "--set", self.form(form), "-o", f"{stem}.h5",
                    "--summary", f"{stem}.json", "-q"]
         done = subprocess.run(command, env=self.env, capture_output=True, text=True)
@@ -133,20 +144,34 @@ nodes = [[0, 0], [0, {nodes - 1}]]
                     frames[round(float(t), 9)] = np.array(r)
         for suffix in (".h5", ".xmf", ".json"):
             Path(f"{stem}{suffix}").unlink(missing_ok=True)
-        self.say(f"run {nodes}x{nodes} {form} dt {dt:g} T {duration:g}: exit {done.returncode} "
+        self.say(f"run {support} {nodes}x{nodes} {form} dt {dt:g} T {duration:g}: exit {done.returncode} "
                  f"{summary.get('status')} wall {summary.get('wall_seconds')} s "
                  f"{done.stderr.strip()[-300:]}")
         return job, summary, frames
 
-    def refinement(self, levels, dt, duration, samples):
+    def refinement(self, levels, dt, duration, samples, supports):
         grids = [9 * 2 ** j + 1 for j in range(levels)]
-        jobs = [(n, form, dt, duration, samples) for n in reversed(grids) for form in FORMS]
-        # The time-error check: the middle grid again at dt / 2.
         check = grids[min(2, levels - 1)]
-        jobs += [(check, form, dt / 2, duration, samples) for form in FORMS]
+        jobs = []
+        for support in supports:  # the largest runs first, so that the two workers end together
+            jobs += [(support, n, form, dt, duration, samples) for n in reversed(grids)
+                     for form in FORMS]
+            # The time-error check: the middle grid again at dt / 2.
+            jobs += [(support, check, form, dt / 2, duration, samples) for form in FORMS]
+        jobs.sort(key=lambda job: -job[1] ** 2 / job[3])
         with concurrent.futures.ThreadPoolExecutor(self.workers) as pool:
             results = list(pool.map(self.run, jobs))
-        runs = {(job[0], job[1], job[2]): (summary, frames) for job, summary, frames in results}
+        rows = []
+        for support in supports:
+            rows += self.compare(support, grids, check, dt, duration,
+                                 [r for r in results if r[0][0] == support])
+        walls = [{"support": job[0], "nodes": job[1], "form": job[2], "dt": job[3],
+                  "wall_seconds": s.get("wall_seconds"), "status": s.get("status"),
+                  "area_ratio": s.get("area_ratio")} for job, s, _ in results]
+        return rows, walls
+
+    def compare(self, support, grids, check, dt, duration, results):
+        runs = {(job[1], job[2], job[3]): (summary, frames) for job, summary, frames in results}
         for key, (summary, frames) in runs.items():
             if not frames:
                 raise SystemExit(f"refinement run {key} failed: {summary}")
@@ -170,6 +195,12 @@ nodes = [[0, 0], [0, {nodes - 1}]]
                              "rms": rms_, "max": max_})
                 if n != grids[0]:
                     coarser = (n - 1) // 2 + 1
+                    # Richardson with order 1 (each form's observed order): 2 r_h - r_2h.
+                    extra = {form: 2 * pos[form] - common(coarser, runs[(coarser, form, dt)][1], t)
+                             for form in FORMS}
+                    rms_, max_ = distance(extra["energy"], extra["flux"])
+                    rows.append({"time": t, "quantity": "extrapolated energy-flux", "nodes": n,
+                                 "h": h, "rms": rms_, "max": max_})
                     for form in FORMS:
                         rms_, max_ = distance(pos[form],
                                               common(coarser, runs[(coarser, form, dt)][1], t))
@@ -182,11 +213,8 @@ nodes = [[0, 0], [0, {nodes - 1}]]
                         rows.append({"time": t, "quantity": f"{form} dt/2", "nodes": n,
                                      "h": h, "rms": rms_, "max": max_})
         for r in rows:
-            r.update(dt=dt, duration=duration)
-        walls = [{"nodes": job[0], "form": job[1], "dt": job[2],
-                  "wall_seconds": s.get("wall_seconds"), "status": s.get("status"),
-                  "area_ratio": s.get("area_ratio")} for job, s, _ in results]
-        return rows, walls
+            r.update(support=support, dt=dt, duration=duration)
+        return rows
 
     # ------------------------------------------------------------------------------------------
     def throughput(self, nodes, steps, dt, repetitions, threads):
@@ -272,104 +300,130 @@ def report(stem, context, notes):
         lines.append("")
 
     if Path(stem + "-refinement.csv").exists():
-        rows = read_csv(stem + "-refinement.csv")
-        dt, duration = float(rows[0]["dt"]), float(rows[0]["duration"])
-        times = sorted({float(r["time"]) for r in rows})
-        grids = sorted({int(r["nodes"]) for r in rows})
+        all_rows = read_csv(stem + "-refinement.csv")
+        for r in all_rows:
+            r.setdefault("support", "corners")
+        supports = list(dict.fromkeys(r["support"] for r in all_rows))
+        dt, duration = float(all_rows[0]["dt"]), float(all_rows[0]["duration"])
+        times = sorted({float(r["time"]) for r in all_rows})
+        grids = sorted({int(r["nodes"]) for r in all_rows})
         lines += ["## Refinement: an S1-like sheet on nested grids", "",
-                  f"S1's sheet, material, gravity, damping and supports (the corners [0, 0] and "
-                  f"[0, n−1], held throughout) on n × n nodes, n = {', '.join(map(str, grids))} "
-                  f"(9·2^j + 1: each grid's nodes include every node of the coarser ones, "
-                  f"h = 10/(n−1) m halves exactly). Both forms, Verlet, Δt = {dt:g} s at every "
-                  f"grid, to T = {duration:g} s. Distances are measured at the {grids[0]}² "
-                  f"nodes of the coarsest grid (every 2^j-th node of the finer ones), as "
-                  f"|Δr| / 10 m, RMS and max over those {grids[0] ** 2} points. Order: log2 of "
-                  f"the ratio of successive values (h halves).", ""]
-        for t in times:
-            at = [r for r in rows if float(r["time"]) == t]
+                  f"S1's sheet, material, gravity and damping on n × n nodes, n = "
+                  f"{', '.join(map(str, grids))} (9·2^j + 1: each grid's nodes include every "
+                  f"node of the coarser ones, h = 10/(n−1) m halves exactly), held throughout "
+                  "by one of two supports:", "",
+                  "- **corners**: S1's own, the corner nodes [0, 0] and [0, n−1] of the x1 = 0 "
+                  "edge. A point support of a membrane is singular (the continuum sheet's "
+                  "stretch near it grows without bound, logarithmically, as the support "
+                  "shrinks), so on finer grids the sheet hangs lower near the corners and "
+                  "neither form need converge there;",
+                  "- **segments**: the x1 = 0 edge from each of those corners to the 10² grid's "
+                  "next node (10/9 m at each end; nodes [0, 0…(n−1)/9] and [0, n−1−(n−1)/9…n−1]) "
+                  "— the same physical support on every grid;",
+                  "- **segments-undamped**: the same without the medium damping. The forms "
+                  "damp alike only at rest area: the flux form's damping is ϱ_D/μ with μ = M/S "
+                  "at the current area S, the energy form's uses the rest density μ0 = M/S0 "
+                  "(constant nodal mass, §2.5). The hanging sheet stretches by S/S0 ≈ 1.011, "
+                  "so the flux form damps 1 % harder: a difference of the models, not of the "
+                  "grids, which no refinement removes.", "",
+                  "\"Extrapolated\": the distance between the forms' Richardson extrapolations "
+                  "2 r_h − r_2h (order 1, each form's observed order), an estimate of how far "
+                  "apart their limits h → 0 are.", "",
+                  f"Both forms, Verlet, Δt = {dt:g} s at every grid, to T = {duration:g} s. "
+                  f"Distances are measured at the {grids[0]}² nodes of the coarsest grid (every "
+                  f"2^j-th node of the finer ones), as |Δr| / 10 m, RMS and max over those "
+                  f"{grids[0] ** 2} points. Order: log2 of the ratio of successive values "
+                  "(h halves).", ""]
+        for support in supports:
+            rows = [r for r in all_rows if r["support"] == support]
+            for t in times:
+                at = [r for r in rows if float(r["time"]) == t]
+                lines += [f"### {support}, t = {t:g} s", "",
+                          "| n | h (m) | energy − flux RMS | order | energy − flux max | order "
+                          "| extrapolated: RMS | max |",
+                          "|---|---|---|---|---|---|---|---|"]
+                prev = None
+                for n in grids:
+                    r = next(r for r in at if r["quantity"] == "energy-flux"
+                             and int(r["nodes"]) == n)
+                    o = (f"{order(prev['rms'], r['rms']):.2f}",
+                         f"{order(prev['max'], r['max']):.2f}") if prev else ("", "")
+                    x = next((r for r in at if r["quantity"] == "extrapolated energy-flux"
+                              and int(r["nodes"]) == n), None)
+                    xs = f"{float(x['rms']):.3e} | {float(x['max']):.3e}" if x else " | "
+                    lines.append(f"| {n} | {float(r['h']):.4f} | {float(r['rms']):.3e} | {o[0]} "
+                                 f"| {float(r['max']):.3e} | {o[1]} | {xs} |")
+                    prev = r
+                lines += ["", "Self-convergence: each form against itself on the next coarser "
+                          "grid.", "", "| grids | h of the finer (m) | flux RMS | order "
+                          "| flux max | order | energy RMS | order | energy max | order |",
+                          "|---|---|---|---|---|---|---|---|---|---|"]
+                prev = {}
+                for n in grids[1:]:
+                    cells = []
+                    for form in FORMS:
+                        r = next(r for r in at if int(r["nodes"]) == n
+                                 and r["quantity"].startswith(form + " ")
+                                 and "->" in r["quantity"])
+                        p = prev.get(form)
+                        cells += [f"{float(r['rms']):.3e}",
+                                  f"{order(p['rms'], r['rms']):.2f}" if p else "",
+                                  f"{float(r['max']):.3e}",
+                                  f"{order(p['max'], r['max']):.2f}" if p else ""]
+                        prev[form] = r
+                    lines.append(f"| {(n - 1) // 2 + 1} → {n} | {SIZE / (n - 1):.4f} | "
+                                 + " | ".join(cells) + " |")
+                checks = [r for r in at if r["quantity"].endswith("dt/2")]
+                if checks:
+                    lines += ["", "Time error: the same grid at Δt and Δt/2 (Verlet, second "
+                              "order: the error of the Δt run is about 4/3 of this difference), "
+                              "against the space differences above:", ""]
+                    for r in checks:
+                        lines.append(f"- {r['quantity'].split()[0]}, {r['nodes']}²: RMS "
+                                     f"{float(r['rms']):.2e}, max {float(r['max']):.2e}")
+                lines.append("")
 
-            def get(q, n):
-                for r in at:
-                    if r["quantity"] == q and int(r["nodes"]) == n:
-                        return r
-                return None
-
-            lines += [f"### t = {t:g} s", "",
-                      "| n | h (m) | energy − flux RMS | order | energy − flux max | order |",
-                      "|---|---|---|---|---|---|"]
-            prev = None
-            for n in grids:
-                r = get("energy-flux", n)
-                o = (f"{order(prev['rms'], r['rms']):.2f}", f"{order(prev['max'], r['max']):.2f}") \
-                    if prev else ("", "")
-                lines.append(f"| {n} | {float(r['h']):.4f} | {float(r['rms']):.3e} | {o[0]} | "
-                             f"{float(r['max']):.3e} | {o[1]} |")
-                prev = r
-            lines += ["", "Self-convergence: each form against itself on the next coarser grid.",
-                      "", "| grids | h of the finer (m) | flux RMS | order | flux max | order "
-                      "| energy RMS | order | energy max | order |",
-                      "|---|---|---|---|---|---|---|---|---|---|"]
-            prev = {}
-            for n in grids[1:]:
-                cells = []
-                for form in FORMS:
-                    r = next(r for r in at if int(r["nodes"]) == n
-                             and r["quantity"].startswith(form + " ") and "->" in r["quantity"])
-                    p = prev.get(form)
-                    cells += [f"{float(r['rms']):.3e}",
-                              f"{order(p['rms'], r['rms']):.2f}" if p else "",
-                              f"{float(r['max']):.3e}",
-                              f"{order(p['max'], r['max']):.2f}" if p else ""]
-                    prev[form] = r
-                lines.append(f"| {(n - 1) // 2 + 1} → {n} | {SIZE / (n - 1):.4f} | "
-                             + " | ".join(cells) + " |")
-            checks = [r for r in at if r["quantity"].endswith("dt/2")]
-            if checks:
-                lines += ["", "Time error: the same grid at Δt and Δt/2 (Verlet, second order: "
-                          "the error of the Δt run is about 4/3 of this difference), against "
-                          "the space differences above:", ""]
-                for r in checks:
-                    lines.append(f"- {r['quantity'].split()[0]}, {r['nodes']}²: RMS "
-                                 f"{float(r['rms']):.2e}, max {float(r['max']):.2e}")
-            lines.append("")
-
-        fig, axes = plt.subplots(1, len(times), figsize=(6 * len(times), 4.8), squeeze=False)
-        for ax, t in zip(axes[0], times):
-            at = [r for r in rows if float(r["time"]) == t]
-            for q, style, label in [("energy-flux", "k", "energy − flux")] + \
-                    [(form, c, f"{form}: n vs its coarser grid")
-                     for form, c in zip(FORMS, ["tab:blue", "tab:red"])]:
-                sel = [r for r in at if r["quantity"] == q
-                       or (q in FORMS and r["quantity"].startswith(q + " ")
-                           and "->" in r["quantity"])]
-                sel.sort(key=lambda r: -float(r["h"]))
-                hs = [float(r["h"]) for r in sel]
-                ax.loglog(hs, [float(r["rms"]) for r in sel], "o-", color=style,
-                          label=f"{label}, RMS")
-                ax.loglog(hs, [float(r["max"]) for r in sel], "s--", color=style,
-                          label=f"{label}, max", alpha=0.6)
-            h = np.array(sorted({float(r["h"]) for r in at}))
-            ref = float(next(r["rms"] for r in at if r["quantity"] == "energy-flux"
-                             and float(r["h"]) == h.max()))
-            ax.loglog(h, ref * (h / h.max()), ":", color="gray", label="O(h)")
-            ax.loglog(h, ref * (h / h.max()) ** 2, "-.", color="gray", label="O(h²)")
-            ax.set_xlabel("h of the (finer) grid (m)")
-            ax.set_ylabel("|Δr| / 10 m at the coarsest grid's nodes")
-            ax.set_title(f"S1-like sheet, t = {t:g} s, Δt = {dt:g} s")
-            ax.grid(True, which="both", alpha=0.3)
-            ax.legend(fontsize=7)
+        fig, axes = plt.subplots(len(supports), len(times),
+                                 figsize=(6 * len(times), 4.8 * len(supports)), squeeze=False)
+        for row_axes, support in zip(axes, supports):
+            rows = [r for r in all_rows if r["support"] == support]
+            for ax, t in zip(row_axes, times):
+                at = [r for r in rows if float(r["time"]) == t]
+                for q, style, label in [("energy-flux", "k", "energy − flux")] + \
+                        [(form, c, f"{form}: n vs its coarser grid")
+                         for form, c in zip(FORMS, ["tab:blue", "tab:red"])]:
+                    sel = [r for r in at if r["quantity"] == q
+                           or (q in FORMS and r["quantity"].startswith(q + " ")
+                               and "->" in r["quantity"])]
+                    sel.sort(key=lambda r: -float(r["h"]))
+                    hs = [float(r["h"]) for r in sel]
+                    ax.loglog(hs, [float(r["rms"]) for r in sel], "o-", color=style,
+                              label=f"{label}, RMS")
+                    ax.loglog(hs, [float(r["max"]) for r in sel], "s--", color=style,
+                              label=f"{label}, max", alpha=0.6)
+                h = np.array(sorted({float(r["h"]) for r in at}))
+                ref = max(float(r["rms"]) for r in at if "->" in r["quantity"])
+                ax.loglog(h, ref * (h / h.max()), ":", color="gray", label="O(h)")
+                ax.loglog(h, ref * (h / h.max()) ** 2, "-.", color="gray", label="O(h²)")
+                ax.set_xlabel("h of the (finer) grid (m)")
+                ax.set_ylabel("|Δr| / 10 m at the coarsest grid's nodes")
+                ax.set_title(f"{support} supports, t = {t:g} s, Δt = {dt:g} s")
+                ax.grid(True, which="both", alpha=0.3)
+                ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(stem + "-refinement.png", dpi=110)
+        fig.savefig(stem + "-refinement.png", dpi=100)
         lines += [f"![refinement]({Path(stem).name}-refinement.png)", ""]
         if Path(stem + "-refinement-runs.csv").exists():
             runs = read_csv(stem + "-refinement-runs.csv")
-            lines += ["Wall time of each refinement run (s, 1 thread, two runs side by side):", "",
-                      "| n | Δt | flux | energy |", "|---|---|---|---|"]
-            seen = sorted({(int(r["nodes"]), float(r["dt"])) for r in runs})
-            for n, d in seen:
-                w = {r["form"]: float(r["wall_seconds"]) for r in runs
-                     if int(r["nodes"]) == n and float(r["dt"]) == d}
-                lines.append(f"| {n} | {d:g} | {w.get('flux', float('nan')):.2f} | "
+            for r in runs:
+                r.setdefault("support", "corners")
+            lines += ["Wall time of each refinement run (s, 1 rank × 1 thread, two runs side by "
+                      "side):", "", "| support | n | Δt | flux | energy |", "|---|---|---|---|---|"]
+            seen = sorted({(r["support"], int(r["nodes"]), float(r["dt"])) for r in runs})
+            for sup, n, d in seen:
+                w = {r["form"]: float(r["wall_seconds"]) for r in runs if r["support"] == sup
+                     and int(r["nodes"]) == n and float(r["dt"]) == d}
+                lines.append(f"| {sup} | {n} | {d:g} | {w.get('flux', float('nan')):.2f} | "
                              f"{w.get('energy', float('nan')):.2f} |")
             lines.append("")
 
@@ -410,6 +464,9 @@ def main():
     parser.add_argument("--levels", type=int, default=5, help="grids 9*2^j+1, j < LEVELS")
     parser.add_argument("--dt", type=float, default=1e-4)
     parser.add_argument("--time", type=float, default=2.0, help="refinement runs' T")
+    parser.add_argument("--supports", default="corners,segments,segments-undamped",
+                        help="refinement sheets: corners (S1's supports), segments, and either "
+                        "with -undamped")
     parser.add_argument("--samples", type=int, default=2, help="compared times in (0, T]")
     parser.add_argument("--tp-nodes", type=int, default=1024)
     parser.add_argument("--tp-steps", type=int, default=40)
@@ -432,7 +489,8 @@ def main():
             if "stability" in parts:
                 write_csv(stem + "-stability.csv", study.stability(args.stability_time))
             if "refinement" in parts:
-                rows, walls = study.refinement(args.levels, args.dt, args.time, args.samples)
+                rows, walls = study.refinement(args.levels, args.dt, args.time, args.samples,
+                                               args.supports.split(","))
                 write_csv(stem + "-refinement.csv", rows)
                 write_csv(stem + "-refinement-runs.csv", walls)
             if "throughput" in parts:
