@@ -6,7 +6,8 @@
 # the distance between the forms and each form's self-convergence, and node-steps/s of both
 # forms on a 1024 x 1024 sheet with 1 and 2 threads. Writes
 # benchmarks/results/parity-<host>-<date>{.md,-stability.csv,-refinement.csv,
-# -refinement-runs.csv,-throughput.csv,-refinement.png,.log}. About 25 min on two shared cores.
+# -refinement-runs.csv,-throughput.csv,-refinement.png,.log}. About 17 min on the 2-core VM (measured under load 4-9);
+# --parts stability,refinement,throughput runs a part (its CSV is replaced, the report redone).
 # The binary: $COSSERAT if set (no build), else the release build made here.
 #   [COSSERAT=path/to/cosserat] benchmarks/run_parity.sh [tools/parity_study.py options]
 set -euo pipefail

@@ -272,7 +272,9 @@ def report(stem, context, notes):
     import matplotlib.pyplot as plt
 
     lines = [f"# Parity of the energy form with the flux form, {context['date']}", "",
-             f"Machine: {context['machine']}. Build: {context['build']}. "
+             f"Machine: {context['machine']}. Build: "
+             + ("; ".join(f"{b} (parts run: {parts})" for parts, b in notes["builds"].items())
+                if notes.get("builds") else context["build"]) + ". "
              f"Ranks × threads: {context['layout']}. Date: {context['date']}.",
              f"Regenerate with `benchmarks/run_parity.sh` (binary: {context['binary']}); "
              f"the log of every run: `{Path(stem).name}.log`.", ""]
@@ -504,6 +506,7 @@ def main():
                 notes["load"] = (f"{' / '.join(before)} (1/5/15 min) before, "
                                  f"{' / '.join(after)} after; the machine has "
                                  f"{os.cpu_count()} cores")
+            notes.setdefault("builds", {})[args.parts] = context.get("build", "")
             notes.setdefault("walls", {})[args.parts] = f"{(time.time() - started) / 60:.1f} min"
             notes_path.write_text(json.dumps(notes))
         finally:
