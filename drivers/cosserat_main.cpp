@@ -169,6 +169,47 @@ std::optional<int> bad_input(const std::string& scene_path, int rank, Work&& wor
   return std::nullopt;
 }
 
+// The files a run will write, checked before any work (DESIGN.md principle 6): none may be the
+// scene, the checkpoint it restarts from (but its own checkpoint, which a restart continues) or
+// another of them, and the summary's folder must take a file. Returns what is wrong, or nothing.
+std::optional<std::string> output_conflict(const RunOptions& options, const std::string& output) {
+  namespace fs = std::filesystem;
+  struct Named {
+    std::string what, path;
+  };
+  std::vector<Named> written{{"--output", output}, {"the XDMF file", cosserat::xdmf_path(output)}};
+  if (options.checkpoint_every > 0)
+    written.push_back({"the checkpoint", cosserat::checkpoint_path(output)});
+  if (!options.summary.empty()) written.push_back({"--summary", options.summary});
+  std::vector<Named> read{{"the scene file", options.scene_path}};
+  if (!options.restart.empty()) read.push_back({"--restart", options.restart});
+  auto same = [](const std::string& a, const std::string& b) {
+    std::error_code error;
+    if (fs::exists(a, error) && fs::exists(b, error)) return fs::equivalent(a, b, error);
+    return fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
+  };
+  for (std::size_t i = 0; i < written.size(); ++i) {
+    for (const Named& input : read) {
+      const bool continues_its_checkpoint =
+          written[i].what == "the checkpoint" && input.what == "--restart";
+      if (!continues_its_checkpoint && same(written[i].path, input.path))
+        return fmt::format("{} ({}) would be written over {} ({}); name another output",
+                           written[i].what, written[i].path, input.what, input.path);
+    }
+    for (std::size_t j = 0; j < i; ++j)
+      if (same(written[i].path, written[j].path))
+        return fmt::format("{} and {} would be the same file ({}); name another",
+                           written[j].what, written[i].what, written[i].path);
+  }
+  if (!options.summary.empty()) {
+    const fs::path folder = fs::absolute(options.summary).parent_path();
+    if (!fs::is_directory(folder) || access(folder.c_str(), W_OK) != 0)
+      return fmt::format("--summary {}: cannot write a file in {}", options.summary,
+                         folder.string());
+  }
+  return std::nullopt;
+}
+
 int run(const RunOptions& options, int rank, int ranks) {
   using namespace cosserat;
   Scene scene;
@@ -182,6 +223,17 @@ int run(const RunOptions& options, int rank, int ranks) {
     for (const std::string& warning : scene.warnings) fmt::print(stderr, "warning: {}\n", warning);
   if (!fits_in_memory(scene, decomposition->block(rank, MPI_COMM_WORLD), rank))
     return kExitBadInput;
+  const std::string output = options.output.empty() ? default_output(scene) : options.output;
+  // Rank 0 looks and tells the others, so that all return together even where the ranks' file
+  // systems differ.
+  int conflicting = 0;
+  if (rank == 0)
+    if (const auto conflict = output_conflict(options, output)) {
+      fmt::print(stderr, "error: {}\n", *conflict);
+      conflicting = 1;
+    }
+  MPI_Bcast(&conflicting, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  if (conflicting) return kExitBadInput;
 
   // The semi-implicit baseline checks its solver names with PETSc while it is set up.
   std::unique_ptr<Simulation> simulation_owner;
@@ -201,7 +253,6 @@ int run(const RunOptions& options, int rank, int ranks) {
     }
   }
 
-  const std::string output = options.output.empty() ? default_output(scene) : options.output;
   std::unique_ptr<FrameWriter> writer;
   bool continued = false;
   try {

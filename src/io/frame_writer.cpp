@@ -46,9 +46,6 @@ std::string join_lines(const std::vector<std::string>& lines) {
   return joined;
 }
 
-std::filesystem::path xmf_path_for(const std::string& h5_path) {
-  return std::filesystem::path(h5_path).replace_extension(".xmf");
-}
 
 // A dataset of frames: the first dimension is unlimited and grows by one per written frame.
 Handle create_series(const hdf5::File& file, const char* name, hid_t file_type,
@@ -125,12 +122,16 @@ struct FrameWriter::Datasets {
   Handle step;
 };
 
+std::string xdmf_path(const std::string& h5_path) {
+  return std::filesystem::path(h5_path).replace_extension(".xmf").string();
+}
+
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
                          const std::string& scene_text, const std::string& integrator,
                          const std::string& version, const std::vector<std::string>& overrides)
     : block_(&block),
       h5_path_(h5_path),
-      xmf_path_(xmf_path_for(h5_path).string()),
+      xmf_path_(xdmf_path(h5_path)),
       rank_(rank_in(block.comm)) {
   if (block.m < 1 || block.n < 1)
     throw std::runtime_error(fmt::format("HDF5 file '{}': grid {} x {} has no nodes to write",
@@ -151,7 +152,7 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step)
     : block_(&block),
       h5_path_(h5_path),
-      xmf_path_(xmf_path_for(h5_path).string()),
+      xmf_path_(xdmf_path(h5_path)),
       rank_(rank_in(block.comm)) {
   file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::read_write);
   const std::string what = "reopen for a restart";

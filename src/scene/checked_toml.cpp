@@ -35,7 +35,36 @@ void Origin::fail(const toml::node* node, std::string_view key, std::string_view
   throw SceneError(fmt::format("{}: key '{}': {}", locate(node), key, what));
 }
 
+// toml++ parses a dotted key by recursion and runs out of stack somewhere past 30 000 parts; no
+// scene key has more than four. Keys are what stands before '=' or inside a [header].
+constexpr int kMostKeyParts = 64;
+
+void refuse_absurd_nesting(const std::string& text, const Origin& origin) {
+  std::size_t line_start = 0;
+  for (int line = 1; line_start <= text.size(); ++line) {
+    const std::size_t line_end = std::min(text.find('\n', line_start), text.size());
+    std::string_view content(text.data() + line_start, line_end - line_start);
+    content.remove_prefix(std::min(content.find_first_not_of(" \t"), content.size()));
+    // A [header] up to its ']' (a line of an array of numbers has commas), or the key of a
+    // key = value line; comments and lines that continue a value have none.
+    std::string_view key;
+    if (content.starts_with('#'))
+      key = {};
+    else if (content.starts_with('['))
+      key = content.substr(0, content.find(']'));
+    else if (const auto equals = content.find('='); equals != std::string_view::npos)
+      key = content.substr(0, equals);
+    if (key.find(',') != std::string_view::npos) key = {};
+    const auto parts = std::count(key.begin(), key.end(), '.') + 1;
+    if (parts > kMostKeyParts)
+      throw SceneError(fmt::format("{}:{}: a key of {} dotted parts; scene keys have at most {}",
+                                   origin.path(), line, parts, kMostKeyParts));
+    line_start = line_end + 1;
+  }
+}
+
 toml::table parse_toml(const std::string& text, const Origin& origin) {
+  refuse_absurd_nesting(text, origin);
   try {
     return toml::parse(text, origin.path());
   } catch (const toml::parse_error& error) {

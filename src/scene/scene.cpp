@@ -134,6 +134,9 @@ void read_material(const Table& material, Scene& scene) {
     scene.material.mass = positive(*mass);
   } else if (density) {
     scene.material.mass = positive(*density) * area;
+    if (!std::isfinite(scene.material.mass))
+      density->fail(fmt::format("density x area = {} x {} m^2 is not a finite mass",
+                                density->number(), area));
   } else if (preset) {
     // Preset masses are for a 10 m x 10 m sheet (SCENES.md): keep the areal density.
     scene.material.mass = preset->mass_10x10 * area / 100.0;

@@ -28,14 +28,19 @@ struct Result {
   std::string output;  // stdout and stderr together
 };
 
-Result cosserat(const std::string& arguments) {
-  const std::string command = std::string(COSSERAT_EXE) + " " + arguments + " 2>&1";
+// A shell command line's exit status and everything it printed.
+Result shell(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   std::string output;
   std::array<char, 4096> buffer{};
   while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
   const int raw = pclose(pipe);
   return {WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, output};
+}
+
+Result cosserat(const std::string& arguments) {
+  return shell(std::string(COSSERAT_EXE) + " " + arguments);
 }
 
 class Cli : public ::testing::Test {
@@ -129,6 +134,36 @@ TEST_F(Cli, UnwritableOutputIsBadInput) {
   const Result r = cosserat("run " + scene + " --output " + path("no/such/dir/out.h5"));
   EXPECT_EQ(r.status, 2);
   EXPECT_THAT(r.output, HasSubstr("out.h5"));
+}
+
+// Nothing the user did not name as output is written over, and nothing is run first: an output
+// that is the scene, an output whose XDMF would be itself, a summary that is the output or the
+// scene, a scene whose default output is itself, a summary that cannot be written.
+TEST_F(Cli, OutputsThatWouldOverwriteInputsOrEachOtherAreBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const auto expect_refused = [&](const std::string& arguments, const std::string& says) {
+    const Result r = arguments.starts_with("cd ") ? shell(arguments) : cosserat(arguments);
+    EXPECT_EQ(r.status, 2) << arguments << "\n" << r.output;
+    EXPECT_THAT(r.output, HasSubstr(says)) << arguments;
+  };
+  expect_refused("run " + scene + " -o " + scene, "would be written over the scene file");
+  expect_refused("run " + scene + " -o " + path("x.xmf"), "would be the same file");
+  expect_refused("run " + scene + " -o " + path("o.h5") + " --summary " + path("o.h5"),
+                 "would be the same file");
+  expect_refused("run " + scene + " -o " + path("o.h5") + " --summary " + scene,
+                 "would be written over the scene file");
+  expect_refused("run " + scene + " -o " + path("o.h5") + " --summary " + path("nodir/s.json"),
+                 "cannot write a file in");
+  const std::string own = write_scene("scene.h5", kSmallScene);
+  expect_refused("cd " + dir_.string() + " && " + std::string(COSSERAT_EXE) + " run scene.h5",
+                 "would be written over the scene file");
+  // Nothing ran: no frames anywhere, and the scene files are as written.
+  EXPECT_FALSE(fs::exists(path("o.h5")));
+  EXPECT_FALSE(fs::exists(path("x.xmf")));
+  std::ifstream kept(scene);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(kept), {}), kSmallScene);
+  std::ifstream kept_own(own);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(kept_own), {}), kSmallScene);
 }
 
 TEST_F(Cli, GridTooLargeForTheMachineIsBadInput) {

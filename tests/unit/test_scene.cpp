@@ -644,6 +644,34 @@ TEST(SceneError, UnknownDiscretisationAndEnergyWithPublishedBorders) {
                                     HasSubstr("no published border rules")));
 }
 
+// Issue 12: a header of 50 000 dotted parts crashed the TOML parser; it is refused first, with
+// its line. A value with many dots (an array of numbers on a continuation line) is not a key.
+TEST(SceneError, AbsurdlyNestedKeyIsRefusedBeforeParsing) {
+  std::string header = "[a";
+  for (int i = 0; i < 50000; ++i) header += ".a";
+  header += "]\n";
+  SceneText text;
+  text.tail = header;
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr(":"), HasSubstr("50001 dotted parts")));
+  std::string dots;
+  for (int i = 0; i < 100; ++i) dots += "0.5, ";
+  text.tail = "# see a.b.c = " + dots + "\n[environment]\ninitial_velocity = [\n  0.5, 0.25,\n" +
+              "  0.125]\n[[load]]\nnodes = [[1, 1]]\nforce = [\n" + dots + "0.5]\n";
+  EXPECT_THAT(error_of(text), HasSubstr("key 'load[0].force'"));  // 101 entries, not 3: a value
+  text.tail = "# see a.b.c = " + dots + "\n[environment]\ninitial_velocity = [\n  0.5, 0.25,\n" +
+              "  0.125]\n";
+  EXPECT_EQ(parse(text).initial_velocity.x, 0.5);
+}
+
+// Issue 12: a density that makes the mass overflow is bad input naming the key.
+TEST(SceneError, DensityWhoseMassIsNotFinite) {
+  SceneText text;
+  text.material = "density = 1e300\nzeta = 100\nxi = 0.3\nphi = 0.001\n";
+  text.grid = "nodes = [4, 4]\nsize = [1e10, 1e10]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'material.density'"),
+                                    HasSubstr("not a finite mass")));
+}
+
 TEST(SceneError, NegativeDampingAndViscosity) {
   SceneText text;
   text.tail = "[environment]\ndamping = -0.2\n";

@@ -17,6 +17,9 @@ namespace hdf5 {
 class File;
 }
 
+// The XDMF file written beside the HDF5 file `h5_path`: the same name with .xmf.
+std::string xdmf_path(const std::string& h5_path);
+
 // Every failure throws std::runtime_error naming the file and the operation that failed. Every
 // member is collective over the block's communicator.
 class FrameWriter {
