@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fmt/core.h>
@@ -266,7 +267,9 @@ int run(const RunOptions& options, int rank, int ranks) {
                                              integrator_name(scene.integrator), COSSERAT_VERSION,
                                              scene.overrides);
   } catch (const std::exception& e) {
-    if (rank == 0) fmt::print(stderr, "error: cannot write the output file: {}\n", e.what());
+    // This rank alone may have failed (rank 0 writes the XDMF file): end them all.
+    fmt::print(stderr, "error: cannot write the output file: {}\n", e.what());
+    if (ranks > 1) MPI_Abort(MPI_COMM_WORLD, kExitBadInput);
     return kExitBadInput;
   }
   const std::string checkpoint = checkpoint_path(output);
@@ -364,6 +367,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
     if (!(duration > 0.0))
       throw SceneError(fmt::format("{}: the simulated time must be > 0 (give --time T)",
                                    options.scene_path));
+    check_trial_length(base, duration);
     for (const std::string& name : integrators) {
       std::vector<std::string> overrides = options.overrides;
       overrides.push_back(fmt::format("time.integrator=\"{}\"", name));
@@ -421,6 +425,16 @@ int stable_dt(const StableDtOptions& options, int rank) {
 
 }  // namespace
 
+// CLI11's ranges let NaN through (every comparison with it is false).
+const CLI::Validator finite_number(
+    [](std::string& text) {
+      double value = 0.0;
+      return CLI::detail::lexical_cast(text, value) && std::isfinite(value)
+                 ? std::string()
+                 : "must be a finite number, got " + text;
+    },
+    "FINITE");
+
 int main(int argc, char** argv) {
   int provided = 0;
   MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided);
@@ -462,7 +476,8 @@ int main(int argc, char** argv) {
   run_command->add_option("--until-rest", options.until_rest,
                           "Stop once the kinetic energy is below this fraction of its peak so "
                           "far (e.g. 1e-6); the summary's \"rest\" gives the step")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(CLI::Range(0.0, 1.0))
+      ->check(finite_number);
   run_command->add_option("--petsc", petsc_options,
                           "PETSc options for the semi-implicit integrator, in one string "
                           "(e.g. \"-ksp_type cg -pc_type jacobi -ksp_rtol 1e-8\"); they override "
@@ -524,6 +539,8 @@ int main(int argc, char** argv) {
     status = kExitBadInput;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
+    // The other ranks may be waiting in a collective call for this one: end them all now.
+    if (ranks > 1) MPI_Abort(MPI_COMM_WORLD, kExitFailure);
     status = kExitFailure;
   }
   cosserat::finalize_petsc();

@@ -26,6 +26,7 @@ std::string innermost_hdf5_error() {
 }  // namespace
 
 File::File(const std::string& path, MPI_Comm comm, Mode mode) : path_(path) {
+  if (size_of(comm) > 1) shared_by_ranks() = true;
   // Failures become exceptions carrying HDF5's innermost message; the default handler would
   // also print the whole stack to stderr, from every rank.
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);

@@ -7,6 +7,7 @@
 #include <hdf5.h>
 
 #include <cstdint>
+#include <exception>
 #include <span>
 #include <string>
 #include <utility>
@@ -16,6 +17,15 @@
 
 namespace cosserat::hdf5 {
 
+// Whether a process runs the files of more than one rank. Closing an HDF5 object of such a file
+// is collective: while an exception unwinds on one rank the others are elsewhere, so a close
+// would hang every rank. Handles then stay open, and the driver ends every rank with MPI_Abort
+// (docs/output.md, "When a run fails").
+inline bool& shared_by_ranks() {
+  static bool shared = false;
+  return shared;
+}
+
 // An HDF5 identifier with the close function of its kind.
 class Handle {
  public:
@@ -24,7 +34,7 @@ class Handle {
   Handle() = default;
   Handle(hid_t id, Close close) : id_(id), close_(close) {}
   ~Handle() {
-    if (id_ >= 0) close_(id_);
+    if (id_ >= 0 && !(shared_by_ranks() && std::uncaught_exceptions() > 0)) close_(id_);
   }
   Handle(const Handle&) = delete;
   Handle& operator=(const Handle&) = delete;

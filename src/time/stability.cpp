@@ -15,6 +15,7 @@ StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Com
                          const SchemeFactory& make) {
   Scene trial_scene = scene;
   trial_scene.dt = dt;
+  // Checked by largest_stable_step: a step count that fits a long.
   trial_scene.steps = static_cast<long>(std::ceil(duration / dt - 1e-9));
   const auto start = std::chrono::steady_clock::now();
   Simulation simulation(trial_scene, comm, make);
@@ -39,6 +40,15 @@ StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Com
   return trial;
 }
 
+void check_trial_length(const Scene& scene, double duration) {
+  // Far beyond any affordable trial, and well inside a long.
+  constexpr double kMostSteps = 1e15;
+  if (!(duration / scene.dt <= kMostSteps))
+    throw SceneError(fmt::format("{}: T/dt = {:.3g}/{:.3g} is more than {:.0e} steps; give a "
+                                 "larger time.dt or a shorter --time",
+                                 scene.path, duration, scene.dt, kMostSteps));
+}
+
 StableStep largest_stable_step(const Scene& scene, double duration, double tolerance, MPI_Comm comm,
                                const SchemeFactory& make,
                                const std::function<void(const StabilityTrial&)>& report) {
@@ -48,6 +58,7 @@ StableStep largest_stable_step(const Scene& scene, double duration, double toler
     if (report) report(result.trials.back());
     return result.trials.back().stable;
   };
+  check_trial_length(scene, duration);
   const double floor = 1e-6 * scene.dt;
   double dt = scene.dt;
   if (trial(dt)) {

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -308,20 +309,37 @@ TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
 }
 
 // More ranks than a 3 x 6 grid can be split over (every block must be two nodes wide).
+// `cosserat ARGUMENTS` under mpiexec on `ranks` ranks.
+Result on_ranks(int ranks, const std::string& arguments) {
+  return shell(std::string(COSSERAT_MPIEXEC) + " -n " + std::to_string(ranks) + " " +
+               COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " " + arguments);
+}
+
 TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
-  const std::string command = std::string(COSSERAT_MPIEXEC) + " -n 4 " +
-                              COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE +
-                              " run " + scene + " --set grid.nodes=[3,6] -o " + path("x.h5") +
-                              " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  std::string output;
-  std::array<char, 4096> buffer{};
-  while (std::fgets(buffer.data(), buffer.size(), pipe)) output += buffer.data();
-  const int raw = pclose(pipe);
-  EXPECT_EQ(WIFEXITED(raw) ? WEXITSTATUS(raw) : -1, 2) << output;
-  EXPECT_THAT(output, HasSubstr("cannot be split over 4 MPI ranks"));
+  const Result r = on_ranks(4, "run " + scene + " --set grid.nodes=[3,6] -o " + path("x.h5"));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("cannot be split over 4 MPI ranks"));
   EXPECT_FALSE(fs::exists(path("x.h5")));
+}
+
+// Issue 12: an error on one rank ends every rank, promptly. Rank 0 alone writes the XDMF file;
+// where a folder stands in its way, rank 0 fails at the first frame while rank 1 goes on to its
+// first step. Before, both hung (rank 0 closing the HDF5 file collectively while unwinding); the
+// timeout turns a hang into a failure here instead of in CI.
+TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  fs::create_directories(path("out.xmf"));
+  const auto start = std::chrono::steady_clock::now();
+  const Result r = shell("timeout 60 " + std::string(COSSERAT_MPIEXEC) + " -n 2 " +
+                         COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " run " + scene + " -o " +
+                         path("out.h5"));
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_NE(r.status, 0) << r.output;
+  EXPECT_NE(r.status, 124) << "hung until the timeout: " << r.output;
+  EXPECT_LT(seconds, 30.0);
+  EXPECT_THAT(r.output, HasSubstr("out.xmf"));
 }
 
 

@@ -37,6 +37,10 @@ struct StableStep {
   std::vector<StabilityTrial> trials;
 };
 
+// A step so small that ceil(T/dt) would not fit a long is bad input (SceneError), not a trial
+// of zero steps that calls itself stable.
+void check_trial_length(const Scene& scene, double duration);
+
 // Starting from the scene's dt, doubles or halves until stable and unstable
 // steps bracket the limit, then bisects until they are within `tolerance` of
 // each other (relative to the stable one). Steps above `duration` or below 1e-6
