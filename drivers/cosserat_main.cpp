@@ -109,8 +109,9 @@ class RunObserver : public cosserat::StepObserver {
   void frame() override {
     writer_.write_frame(simulation_.step_index(), simulation_.time(), simulation_.positions());
   }
-  void checkpoint() override {
-    cosserat::write_checkpoint(checkpoint_, simulation_, scene_, COSSERAT_VERSION);
+  void checkpoint(const std::optional<cosserat::RestSummary>& rest) override {
+    cosserat::write_checkpoint(checkpoint_, simulation_, scene_, COSSERAT_VERSION,
+                               rest ? std::optional(rest->peak_kinetic_energy) : std::nullopt);
   }
   void progress(long step) override { progress_.update(step); }
 
@@ -245,9 +246,10 @@ int run(const RunOptions& options, int rank, int ranks) {
     return *status;
   Simulation& simulation = *simulation_owner;
   std::optional<long> restarted_from;
+  std::optional<double> rest_peak;  // --until-rest's peak so far, when the checkpoint has it
   if (!options.restart.empty()) {
     try {
-      restarted_from = read_checkpoint(options.restart, simulation, scene);
+      restarted_from = read_checkpoint(options.restart, simulation, scene, &rest_peak);
     } catch (const CheckpointError& e) {
       if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
       return kExitBadInput;
@@ -261,7 +263,9 @@ int run(const RunOptions& options, int rank, int ranks) {
     // checkpoint are kept, and the frames written after it are written again.
     continued = restarted_from && std::filesystem::exists(output);
     if (continued)
-      writer = std::make_unique<FrameWriter>(output, simulation.block(), *restarted_from);
+      writer = std::make_unique<FrameWriter>(
+          output, simulation.block(), *restarted_from, scene.text,
+          *restarted_from - *restarted_from % scene.output_every);
     else
       writer = std::make_unique<FrameWriter>(output, simulation.block(), scene.text,
                                              integrator_name(scene.integrator), COSSERAT_VERSION,
@@ -294,7 +298,9 @@ int run(const RunOptions& options, int rank, int ranks) {
   Progress progress(scene.steps, scene.dt, on_terminal);
   RunObserver observer(simulation, scene, *writer, checkpoint, progress);
   const StepLoopResult loop = run_step_loop(
-      simulation, scene, StepLoopOptions{options.checkpoint_every, options.until_rest}, observer);
+      simulation, scene,
+      StepLoopOptions{options.checkpoint_every, options.until_rest, rest_peak.value_or(0.0)},
+      observer);
   progress.finish();
 
   const std::optional<Instability>& failure = loop.failure;

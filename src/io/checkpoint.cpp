@@ -115,7 +115,7 @@ std::string checkpoint_path(const std::string& output_path) {
 }
 
 void write_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
-                      const std::string& version) {
+                      const std::string& version, std::optional<double> rest_peak) {
   const Block& b = simulation.block();
   const std::string partial = path + ".partial";
   {
@@ -129,6 +129,7 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
     file.write_attribute("dt", scene.dt);
     file.write_attribute("step", std::int64_t{simulation.step_index()});
     file.write_attribute("time", simulation.time());
+    if (rest_peak) file.write_attribute("peak_kinetic_energy", *rest_peak);
     const std::vector<hsize_t> shape{static_cast<hsize_t>(b.m), static_cast<hsize_t>(b.n), 3};
     for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
       const Handle dataset = create_dataset(file, "/" + f.name, H5T_IEEE_F64LE, shape);
@@ -153,7 +154,8 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
                                          path, reason.empty() ? "see rank 0" : reason));
 }
 
-long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene) {
+long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
+                     std::optional<double>* rest_peak) {
   const Block& b = simulation.block();
   try {
     const hdf5::File file(path, b.comm, hdf5::File::Mode::read);
@@ -170,6 +172,8 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
           path, m, n, integrator, dt, scene.m, scene.n, integrator_name(scene.integrator),
           scene.dt));
     const long step = file.read_int_attribute("step");
+    if (rest_peak != nullptr && file.has_attribute("peak_kinetic_energy"))
+      *rest_peak = file.read_double_attribute("peak_kinetic_energy");
     if (step < 0 || step > scene.steps)
       throw CheckpointError(fmt::format("checkpoint '{}' is at step {}, past this scene's {} steps",
                                         path, step, scene.steps));

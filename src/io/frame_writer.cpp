@@ -149,7 +149,8 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
   file_->flush();
 }
 
-FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step)
+FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step,
+                         const std::string& scene_text, long last_scheduled_frame)
     : block_(&block),
       h5_path_(h5_path),
       xmf_path_(xdmf_path(h5_path)),
@@ -161,12 +162,33 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
                        fmt::format("{}: open {}", what, name));
   };
   datasets_ = std::make_unique<Datasets>(Datasets{open("/positions"), open("/time"), open("/step")});
+  // A restart continues only the output of the same run: checked before anything is changed.
+  auto refuse = [&](const std::string& why) {
+    throw std::runtime_error(
+        fmt::format("{}: {}; a restart continues only the output of the run it restarts "
+                    "(name another --output to start a new file)",
+                    h5_path, why));
+  };
+  if (file_->read_string_attribute("scene") != scene_text)
+    refuse("it was written for another scene text");
+  {
+    const Handle space = file_->open(H5Dget_space(datasets_->positions.get()), H5Sclose, what);
+    std::array<hsize_t, 4> extent{};
+    file_->check(H5Sget_simple_extent_dims(space.get(), extent.data(), nullptr), what);
+    if (extent[1] != static_cast<hsize_t>(block.m) || extent[2] != static_cast<hsize_t>(block.n))
+      refuse(fmt::format("its frames are {} x {} nodes, this run's {} x {}", extent[1],
+                         extent[2], block.m, block.n));
+  }
   const auto steps = read_series<std::int64_t>(*file_, datasets_->step, H5T_NATIVE_INT64, what);
   const auto times = read_series<double>(*file_, datasets_->time, H5T_NATIVE_DOUBLE, what);
   for (std::size_t f = 0; f < steps.size() && f < times.size() && steps[f] <= step; ++f) {
     steps_.push_back(steps[f]);
     times_.push_back(times[f]);
   }
+  if (steps_.empty() || steps_.back() < last_scheduled_frame)
+    refuse(fmt::format("it holds frames up to step {}, and the checkpoint at step {} follows the "
+                       "frame of step {}: the frames between would be missing",
+                       steps_.empty() ? -1 : steps_.back(), step, last_scheduled_frame));
   const auto kept = static_cast<hsize_t>(steps_.size());
   resize_series(*file_, datasets_->positions, kept, what);
   resize_series(*file_, datasets_->time, kept, what);

@@ -124,6 +124,12 @@ std::int64_t File::read_int_attribute(const std::string& name) const {
   return value;
 }
 
+bool File::has_attribute(const std::string& name) const {
+  const htri_t exists = H5Aexists(file_.get(), name.c_str());
+  check(exists, fmt::format("look for attribute '{}'", name));
+  return exists > 0;
+}
+
 double File::read_double_attribute(const std::string& name) const {
   const std::string what = fmt::format("read attribute '{}'", name);
   const Handle attribute = open_attribute(*this, name, what);

@@ -17,7 +17,8 @@ StepLoopResult run_step_loop(Simulation& simulation, const Scene& scene,
   using Clock = std::chrono::steady_clock;
   StepLoopResult result;
   result.first_step = simulation.step_index();
-  if (options.until_rest) result.rest = RestSummary{*options.until_rest, 0.0, std::nullopt};
+  if (options.until_rest)
+    result.rest = RestSummary{*options.until_rest, options.rest_peak, std::nullopt};
   const double halo_before = simulation.halo_seconds();
   const auto start = Clock::now();
   while (simulation.step_index() < scene.steps) {
@@ -29,7 +30,7 @@ StepLoopResult run_step_loop(Simulation& simulation, const Scene& scene,
     if (step % scene.output_every == 0 || step == scene.steps || at_rest) observer.frame();
     if (options.checkpoint_every > 0 &&
         (step % options.checkpoint_every == 0 || step == scene.steps))
-      observer.checkpoint();
+      observer.checkpoint(result.rest);
     observer.progress(step);
     if (at_rest) break;
   }

@@ -269,6 +269,37 @@ TEST_F(Cli, RestartContinuesARunBitwise) {
   EXPECT_THAT(json.str(), HasSubstr("\"restarted_from\": 120"));
 }
 
+// Issue 12: a restart continues only the output of the run it restarts. Another scene's file and
+// a file of the same scene that lacks frames before the checkpoint are refused, unchanged.
+TEST_F(Cli, RestartIntoAnotherRunsOutputIsBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=120 --checkpoint-every 50 -o " +
+                     path("part.h5"))
+                .status,
+            0);
+  std::string other_text = kSmallScene;
+  other_text.replace(other_text.find("nodes = [6, 6]"), 14, "nodes = [8, 8]");
+  const std::string other = write_scene("other.toml", other_text);
+  ASSERT_EQ(cosserat("run " + other + " -q --set time.steps=50 -o " + path("other.h5")).status, 0);
+  ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=50 -o " + path("short.h5")).status, 0);
+  const auto bytes_of = [&](const std::string& name) {
+    std::ifstream in(path(name), std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string other_before = bytes_of("other.h5"), short_before = bytes_of("short.h5");
+
+  const Result into_other = cosserat("run " + scene + " --restart " +
+                                     path("part.checkpoint.h5") + " -o " + path("other.h5"));
+  EXPECT_EQ(into_other.status, 2) << into_other.output;
+  EXPECT_THAT(into_other.output, HasSubstr("written for another scene text"));
+  const Result into_short = cosserat("run " + scene + " --restart " +
+                                     path("part.checkpoint.h5") + " -o " + path("short.h5"));
+  EXPECT_EQ(into_short.status, 2) << into_short.output;
+  EXPECT_THAT(into_short.output, HasSubstr("frames up to step 50"));
+  EXPECT_EQ(bytes_of("other.h5"), other_before);
+  EXPECT_EQ(bytes_of("short.h5"), short_before);
+}
+
 // A run killed (SIGKILL) soon after its first checkpoint (step 1500, between two frames), then
 // restarted: the output file ends up identical, dataset by dataset, to that of a run never
 // interrupted, whatever frames the killed run had written past its checkpoint.
@@ -425,6 +456,29 @@ TEST_F(Cli, UntilRestStopsAtRest) {
   EXPECT_EQ(json_value(json, "steps"), rest_step);
   EXPECT_LT(json_value(json, "kinetic_energy"), 1e-3 * json_value(json, "peak_kinetic_energy"));
   EXPECT_THAT(json, HasSubstr("\"status\": \"ok\""));
+}
+
+// Issue 12: the stop at rest survives a restart. The peak kinetic energy so far travels in the
+// checkpoint, so a run checkpointed before it comes to rest and restarted stops at the step an
+// uninterrupted run stops at (before, the restart started its peak from zero and stopped later).
+TEST_F(Cli, UntilRestIsRestartSafe) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string rest = " --set time.steps=40000 --until-rest 1e-3";
+  ASSERT_EQ(cosserat("run " + scene + rest + " -q -o " + path("whole.h5") + " --summary " +
+                     path("whole.json"))
+                .status,
+            0);
+  const double whole_step = json_value(read_text(path("whole.json")), "step");
+  ASSERT_GT(whole_step, 1500.0);
+  ASSERT_EQ(cosserat("run " + scene + " --set time.steps=1500 --until-rest 1e-3 -q "
+                     "--checkpoint-every 1500 -o " + path("part.h5"))
+                .status,
+            0);
+  const Result restarted = cosserat("run " + scene + rest + " -q --restart " +
+                                    path("part.checkpoint.h5") + " -o " + path("part.h5") +
+                                    " --summary " + path("part.json"));
+  ASSERT_EQ(restarted.status, 0) << restarted.output;
+  EXPECT_EQ(json_value(read_text(path("part.json")), "step"), whole_step);
 }
 
 #if defined(COSSERAT_HAVE_PETSC)

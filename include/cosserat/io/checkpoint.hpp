@@ -4,6 +4,7 @@
 // stored as whole-grid arrays, not per rank).
 
 #include <stdexcept>
+#include <optional>
 #include <string>
 
 #include "cosserat/scene/scene.hpp"
@@ -22,13 +23,16 @@ std::string checkpoint_path(const std::string& output_path);
 
 // Writes the state of `simulation` to `path`: first to `path`.partial, renamed over `path` only
 // once complete and closed, so a run killed while writing leaves the previous checkpoint
-// valid. Collective. Throws std::runtime_error on I/O failure.
+// valid. Collective. Throws std::runtime_error on I/O failure. `rest_peak`: the peak kinetic
+// energy so far of a run with --until-rest, which its restart must continue from.
 void write_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
-                      const std::string& version);
+                      const std::string& version, std::optional<double> rest_peak = {});
 
 // Loads a checkpoint into `simulation`, built for `scene` on any decomposition, and returns its
 // step. Throws CheckpointError if the file cannot be read as a checkpoint or was written for a
 // different grid, integrator or time step. Collective.
-long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene);
+// With `rest_peak`, also the peak kinetic energy the checkpoint carries (empty if none).
+long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
+                     std::optional<double>* rest_peak = nullptr);
 
 }  // namespace cosserat

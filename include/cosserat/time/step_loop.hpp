@@ -26,6 +26,7 @@ struct RestSummary {
 struct StepLoopOptions {
   long checkpoint_every = 0;  // 0: no checkpoints
   std::optional<double> until_rest;
+  double rest_peak = 0.0;  // a restarted run's peak kinetic energy so far (from its checkpoint)
 };
 
 // Told after each good step, in this order: frame and checkpoint when due, then progress. The
@@ -34,7 +35,8 @@ class StepObserver {
  public:
   virtual ~StepObserver() = default;
   virtual void frame() = 0;
-  virtual void checkpoint() = 0;
+  // `rest`: with until_rest, the stop-at-rest state a restart must continue from.
+  virtual void checkpoint(const std::optional<RestSummary>& rest) = 0;
   virtual void progress(long step) = 0;
 };
 
