@@ -173,7 +173,8 @@ std::optional<int> bad_input(const std::string& scene_path, int rank, Work&& wor
 
 // The files a run will write, checked before any work (DESIGN.md principle 6): none may be the
 // scene, the checkpoint it restarts from (but its own checkpoint, which a restart continues) or
-// another of them, and the summary's folder must take a file. Returns what is wrong, or nothing.
+// another of them; each must be a plain file in a folder that takes one. Returns what is wrong,
+// or nothing.
 std::optional<std::string> output_conflict(const RunOptions& options, const std::string& output) {
   namespace fs = std::filesystem;
   struct Named {
@@ -191,6 +192,16 @@ std::optional<std::string> output_conflict(const RunOptions& options, const std:
     return fs::weakly_canonical(a, error) == fs::weakly_canonical(b, error);
   };
   for (std::size_t i = 0; i < written.size(); ++i) {
+    // A device (-o /dev/null) or a folder in the way: HDF5 and the renames of the XDMF and
+    // checkpoint files need a plain file there.
+    std::error_code error;
+    if (fs::exists(written[i].path, error) && !fs::is_regular_file(written[i].path, error))
+      return fmt::format("{} ({}) exists and is not a regular file", written[i].what,
+                         written[i].path);
+    const fs::path folder = fs::absolute(written[i].path).parent_path();
+    if (!fs::is_directory(folder, error) || access(folder.c_str(), W_OK) != 0)
+      return fmt::format("{} ({}): cannot write a file in {}", written[i].what, written[i].path,
+                         folder.string());
     for (const Named& input : read) {
       const bool continues_its_checkpoint =
           written[i].what == "the checkpoint" && input.what == "--restart";
@@ -202,12 +213,6 @@ std::optional<std::string> output_conflict(const RunOptions& options, const std:
       if (same(written[i].path, written[j].path))
         return fmt::format("{} and {} would be the same file ({}); name another",
                            written[j].what, written[i].what, written[i].path);
-  }
-  if (!options.summary.empty()) {
-    const fs::path folder = fs::absolute(options.summary).parent_path();
-    if (!fs::is_directory(folder) || access(folder.c_str(), W_OK) != 0)
-      return fmt::format("--summary {}: cannot write a file in {}", options.summary,
-                         folder.string());
   }
   return std::nullopt;
 }
@@ -271,10 +276,10 @@ int run(const RunOptions& options, int rank, int ranks) {
                                              integrator_name(scene.integrator), COSSERAT_VERSION,
                                              scene.overrides);
   } catch (const std::exception& e) {
-    // This rank alone may have failed (rank 0 writes the XDMF file): end them all.
+    // This rank alone may have failed (rank 0 writes the XDMF file), and a file whose first
+    // write failed crashes HDF5's clean-up in MPI_Finalize: end every rank now.
     fmt::print(stderr, "error: cannot write the output file: {}\n", e.what());
-    if (ranks > 1) MPI_Abort(MPI_COMM_WORLD, kExitBadInput);
-    return kExitBadInput;
+    MPI_Abort(MPI_COMM_WORLD, kExitBadInput);
   }
   const std::string checkpoint = checkpoint_path(output);
 
@@ -545,9 +550,10 @@ int main(int argc, char** argv) {
     status = kExitBadInput;
   } catch (const std::exception& e) {
     fmt::print(stderr, "error: {}\n", e.what());
-    // The other ranks may be waiting in a collective call for this one: end them all now.
-    if (ranks > 1) MPI_Abort(MPI_COMM_WORLD, kExitFailure);
-    status = kExitFailure;
+    // The other ranks may be waiting in a collective call for this one, and an HDF5 file whose
+    // write failed crashes HDF5's own clean-up inside MPI_Finalize: end every rank now, with
+    // this status.
+    MPI_Abort(MPI_COMM_WORLD, kExitFailure);
   }
   cosserat::finalize_petsc();
   MPI_Finalize();

@@ -354,13 +354,13 @@ TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {
   EXPECT_FALSE(fs::exists(path("x.h5")));
 }
 
-// Issue 12: an error on one rank ends every rank, promptly. Rank 0 alone writes the XDMF file;
-// where a folder stands in its way, rank 0 fails at the first frame while rank 1 goes on to its
-// first step. Before, both hung (rank 0 closing the HDF5 file collectively while unwinding); the
-// timeout turns a hang into a failure here instead of in CI.
+// Issue 12: an error on one rank ends every rank, promptly. Rank 0 alone writes the XDMF file,
+// through out.xmf.partial; where a folder stands in its way, rank 0 fails at the first frame
+// while rank 1 goes on to its first step. Before, both hung (rank 0 closing the HDF5 file
+// collectively while unwinding); the timeout turns a hang into a failure here, not in CI.
 TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
   const std::string scene = write_scene("s.toml", kSmallScene);
-  fs::create_directories(path("out.xmf"));
+  fs::create_directories(path("out.xmf.partial"));
   const auto start = std::chrono::steady_clock::now();
   const Result r = shell("timeout 60 " + std::string(COSSERAT_MPIEXEC) + " -n 2 " +
                          COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " run " + scene + " -o " +
@@ -371,6 +371,22 @@ TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
   EXPECT_NE(r.status, 124) << "hung until the timeout: " << r.output;
   EXPECT_LT(seconds, 30.0);
   EXPECT_THAT(r.output, HasSubstr("out.xmf"));
+}
+
+// Issue 12: outputs that are devices or folders are bad input before any work; before, -o
+// /dev/null and -o /dev/full ran, failed to write, and crashed in MPI_Finalize (exit 139).
+TEST_F(Cli, OutputThatIsNotARegularFileIsBadInput) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  for (const std::string output : {"/dev/null", "/dev/full"}) {
+    const Result r = cosserat("run " + scene + " -o " + output);
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_THAT(r.output, HasSubstr("is not a regular file"));
+  }
+  fs::create_directories(path("out.xmf"));
+  const Result r = cosserat("run " + scene + " -o " + path("out.h5"));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("the XDMF file"));
+  EXPECT_FALSE(fs::exists(path("out.h5")));
 }
 
 
