@@ -15,6 +15,7 @@
 #include <cerrno>
 #include <climits>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -133,10 +134,12 @@ void read_material(const Table& material, Scene& scene) {
   if (mass) {
     scene.material.mass = positive(*mass);
   } else if (density) {
-    scene.material.mass = positive(*density) * area;
-    if (!std::isfinite(scene.material.mass))
-      density->fail(fmt::format("density x area = {} x {} m^2 is not a finite mass",
-                                density->number(), area));
+    const double areal = positive(*density);
+    // Compared before multiplying: an overflow would trap in a build with FPE traps on.
+    if (!(areal <= std::numeric_limits<double>::max() / area))
+      density->fail(
+          fmt::format("density x area = {} x {} m^2 is not a finite mass", areal, area));
+    scene.material.mass = areal * area;
   } else if (preset) {
     // Preset masses are for a 10 m x 10 m sheet (SCENES.md): keep the areal density.
     scene.material.mass = preset->mass_10x10 * area / 100.0;
