@@ -29,43 +29,55 @@ inline Terms terms_of(const Neighbours& p) {
   return {p.right && p.up, p.left && p.right, p.down && p.up};
 }
 
-// Adds the gradient that flows back through the unit normal n = s/|s|, s the sum of the unit
-// normals of p's corner triangles (§2.1 rule 2), given G_n = ∂E/∂n.
-void add_normal_gradient(const Field<Vec3>& R, int k, int l, const Neighbours& p, const Vec3& G_n,
-                         CosseratEnergy::StencilGradient& g) {
-  const Vec3 r = R(k, l);
-  Vec3 sum;
+// The unit normal n = s/|s| of §2.1 rule 2, s the sum of the unit normals of p's corner
+// triangles, with what its gradient needs: computed once per node for both. The arithmetic is
+// geometry::unit_normal's, so n is the same bits.
+struct CornerNormals {
   struct Corner {
-    int ek, el, fk, fl;
+    int ek, el, fk, fl;  // the offsets of the corner's two edges' far nodes
+    Vec3 E, F;           // the edges r_e − r, r_f − r
+    Vec3 unit;           // (E × F)/|E × F|
+    double length;       // |E × F|
   };
-  Corner corners[4];
+  Corner corner[4];
   int count = 0;
-  if (p.right && p.up) corners[count++] = {1, 0, 0, 1};
-  if (p.up && p.left) corners[count++] = {0, 1, -1, 0};
-  if (p.left && p.down) corners[count++] = {-1, 0, 0, -1};
-  if (p.down && p.right) corners[count++] = {0, -1, 1, 0};
-  Vec3 unit[4];
-  double length[4];
-  for (int i = 0; i < count; ++i) {
-    const Corner& c = corners[i];
-    const Vec3 cross_product =
-        cross(R(k + c.ek, l + c.el) - r, R(k + c.fk, l + c.fl) - r);
-    length[i] = norm(cross_product);
-    unit[i] = cross_product / length[i];
-    sum += unit[i];
-  }
-  const double sum_length = norm(sum);
-  const Vec3 n = sum / sum_length;
+  double sum_length = 0.0;  // |s|
+  Vec3 n;
+};
+
+CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbours& p) {
+  const Vec3 r = R(k, l);
+  CornerNormals c;
+  auto add = [&](int ek, int el, int fk, int fl) {
+    CornerNormals::Corner& q = c.corner[c.count++];
+    q = {ek, el, fk, fl, R(k + ek, l + el) - r, R(k + fk, l + fl) - r, {}, 0.0};
+    const Vec3 cross_product = cross(q.E, q.F);
+    q.length = norm(cross_product);
+    q.unit = cross_product / q.length;
+  };
+  if (p.right && p.up) add(1, 0, 0, 1);
+  if (p.up && p.left) add(0, 1, -1, 0);
+  if (p.left && p.down) add(-1, 0, 0, -1);
+  if (p.down && p.right) add(0, -1, 1, 0);
+  Vec3 sum;
+  for (int i = 0; i < c.count; ++i) sum += c.corner[i].unit;
+  c.sum_length = norm(sum);
+  c.n = sum / c.sum_length;
+  return c;
+}
+
+// Adds the gradient that flows back through n, given G_n = ∂E/∂n.
+void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
+                         CosseratEnergy::StencilGradient& g) {
   // d(s/|s|) projects out n and divides by |s|; the same for each corner's c/|c|.
-  const Vec3 G_s = (G_n - dot(G_n, n) * n) / sum_length;
-  for (int i = 0; i < count; ++i) {
-    const Corner& c = corners[i];
-    const Vec3 G_c = (G_s - dot(G_s, unit[i]) * unit[i]) / length[i];
-    const Vec3 E = R(k + c.ek, l + c.el) - r, F = R(k + c.fk, l + c.fl) - r;
+  const Vec3 G_s = (G_n - dot(G_n, c.n) * c.n) / c.sum_length;
+  for (int i = 0; i < c.count; ++i) {
+    const CornerNormals::Corner& q = c.corner[i];
+    const Vec3 G_c = (G_s - dot(G_s, q.unit) * q.unit) / q.length;
     // c = E × F: G_c · (δE × F) = δE · (F × G_c), G_c · (E × δF) = δF · (G_c × E).
-    const Vec3 G_E = cross(F, G_c), G_F = cross(G_c, E);
-    g[slot(c.ek, c.el)] += G_E;
-    g[slot(c.fk, c.fl)] += G_F;
+    const Vec3 G_E = cross(q.F, G_c), G_F = cross(G_c, q.E);
+    g[slot(q.ek, q.el)] += G_E;
+    g[slot(q.fk, q.fl)] += G_F;
     g[slot(0, 0)] -= G_E + G_F;
   }
 }
@@ -84,7 +96,8 @@ double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGr
   const Terms has = terms_of(p);
   const double h1 = h1_, h2 = h2_;
   const Tangents a = tangents(R, k, l, p, h1, h2);
-  const Vec3 n = unit_normal(R, k, l, p);
+  const CornerNormals corners = corner_normals(R, k, l, p);
+  const Vec3 n = corners.n;
   if (normal != nullptr) *normal = n;
   const SecondDerivatives X = second_derivatives(R, k, l, p, h1, h2);
   const Metric g = metric(a);
@@ -150,7 +163,7 @@ double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGr
     G[slot(0, 1)] -= G_X;
     G_n -= M12 * X.r12;
   }
-  add_normal_gradient(R, k, l, p, G_n, G);
+  add_normal_gradient(corners, G_n, G);
   return energy;
 }
 
