@@ -70,8 +70,7 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   if (loop.failure) summary.unstable_step = loop.failure->step;
   summary.area_ratio = diagnostics.area_ratio;
   summary.max_speed = diagnostics.max_speed;
-  summary.discretisation =
-      scene.discretisation == Discretisation::energy ? "energy" : "flux";
+  summary.discretisation = discretisation_name(scene.discretisation);
   summary.kinetic_energy = diagnostics.kinetic_energy;
   summary.elastic_energy = simulation.elastic_energy();
   summary.gravitational_energy = diagnostics.gravitational_energy;

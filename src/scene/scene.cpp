@@ -170,14 +170,15 @@ void read_model(const Table& model, Scene& scene) {
   }
   if (const auto discretisation = model.find("discretisation")) {
     const std::string name = discretisation->string();
-    if (name == "flux") {
-      scene.discretisation = Discretisation::flux;
-    } else if (name == "energy") {
-      scene.discretisation = Discretisation::energy;
-    } else {
+    bool known = false;
+    for (const Discretisation d : {Discretisation::flux, Discretisation::energy})
+      if (name == discretisation_name(d)) {
+        scene.discretisation = d;
+        known = true;
+      }
+    if (!known)
       discretisation->fail(
           fmt::format("unknown discretisation \"{}\"; allowed: flux, energy", name));
-    }
     // The energy form's border terms are MODEL.md §2.5's; the published rules are the flux
     // form's alone.
     if (scene.discretisation == Discretisation::energy && scene.borders == Borders::published)

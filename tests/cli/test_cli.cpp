@@ -340,15 +340,16 @@ TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
 }
 
 // More ranks than a 3 x 6 grid can be split over (every block must be two nodes wide).
-// `cosserat ARGUMENTS` under mpiexec on `ranks` ranks.
-Result on_ranks(int ranks, const std::string& arguments) {
-  return shell(std::string(COSSERAT_MPIEXEC) + " -n " + std::to_string(ranks) + " " +
-               COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " " + arguments);
+// The command line of `cosserat ARGUMENTS` under mpiexec on `ranks` ranks.
+std::string on_ranks(int ranks, const std::string& arguments) {
+  return std::string(COSSERAT_MPIEXEC) + " -n " + std::to_string(ranks) + " " +
+         COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " " + arguments;
 }
 
 TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
-  const Result r = on_ranks(4, "run " + scene + " --set grid.nodes=[3,6] -o " + path("x.h5"));
+  const Result r =
+      shell(on_ranks(4, "run " + scene + " --set grid.nodes=[3,6] -o " + path("x.h5")));
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_THAT(r.output, HasSubstr("cannot be split over 4 MPI ranks"));
   EXPECT_FALSE(fs::exists(path("x.h5")));
@@ -362,9 +363,7 @@ TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   fs::create_directories(path("out.xmf.partial"));
   const auto start = std::chrono::steady_clock::now();
-  const Result r = shell("timeout 60 " + std::string(COSSERAT_MPIEXEC) + " -n 2 " +
-                         COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " run " + scene + " -o " +
-                         path("out.h5"));
+  const Result r = shell("timeout 60 " + on_ranks(2, "run " + scene + " -o " + path("out.h5")));
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_NE(r.status, 0) << r.output;

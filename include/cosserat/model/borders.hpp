@@ -8,6 +8,11 @@ namespace cosserat {
 // force taken as its exact gradient (§2.5).
 enum class Discretisation { flux, energy };
 
+// As written in scene files and the run summary.
+inline const char* discretisation_name(Discretisation d) {
+  return d == Discretisation::energy ? "energy" : "flux";
+}
+
 enum class Borders { symmetric, published };
 
 }  // namespace cosserat
