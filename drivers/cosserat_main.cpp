@@ -65,22 +65,29 @@ struct StableDtOptions {
   bool quiet = false;
 };
 
-// One line, rewritten in place, while the run goes: only on a terminal.
+// One line, rewritten in place, while the run goes: only on a terminal. The ETA is from
+// simulated time, which adaptive steps cover at a varying rate of steps.
 class Progress {
  public:
-  Progress(long total_steps, double dt, bool enabled)
-      : total_(total_steps), dt_(dt), enabled_(enabled), start_(Clock::now()), last_(start_) {}
+  Progress(long first_step, double first_time, double duration, bool enabled)
+      : first_step_(first_step),
+        first_time_(first_time),
+        duration_(duration),
+        enabled_(enabled),
+        start_(Clock::now()),
+        last_(start_) {}
 
-  void update(long step) {
+  void update(long step, double time) {
     if (!enabled_) return;
     const auto now = Clock::now();
-    if (now - last_ < std::chrono::milliseconds(200) && step != total_) return;
+    if (now - last_ < std::chrono::milliseconds(200) && time < duration_) return;
     last_ = now;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const double rate = elapsed > 0.0 ? static_cast<double>(step) / elapsed : 0.0;
-    const double eta = rate > 0.0 ? static_cast<double>(total_ - step) / rate : 0.0;
-    fmt::print(stderr, "\rstep {}/{}  t = {:.4f} s  {:.0f} steps/s  ETA {:.0f} s   ", step,
-               total_, static_cast<double>(step) * dt_, rate, eta);
+    const double rate = elapsed > 0.0 ? static_cast<double>(step - first_step_) / elapsed : 0.0;
+    const double covered = time - first_time_;
+    const double eta = covered > 0.0 ? (duration_ - time) * elapsed / covered : 0.0;
+    fmt::print(stderr, "\rstep {}  t = {:.4f} / {} s  {:.0f} steps/s  ETA {:.0f} s   ", step,
+               time, duration_, rate, eta);
     std::fflush(stderr);
   }
   void finish() {
@@ -88,8 +95,8 @@ class Progress {
   }
 
  private:
-  long total_;
-  double dt_;
+  long first_step_;
+  double first_time_, duration_;
   bool enabled_;
   Clock::time_point start_, last_;
 };
@@ -109,11 +116,13 @@ class RunObserver : public cosserat::StepObserver {
   void frame() override {
     writer_.write_frame(simulation_.step_index(), simulation_.time(), simulation_.positions());
   }
-  void checkpoint(const std::optional<cosserat::RestSummary>& rest) override {
-    cosserat::write_checkpoint(checkpoint_, simulation_, scene_, COSSERAT_VERSION,
-                               rest ? std::optional(rest->peak_kinetic_energy) : std::nullopt);
+  void checkpoint(const cosserat::LoopCarry& carry) override {
+    cosserat::write_checkpoint(
+        checkpoint_, simulation_, scene_, COSSERAT_VERSION,
+        carry.rest ? std::optional(carry.rest->peak_kinetic_energy) : std::nullopt,
+        carry.adaptive_scale);
   }
-  void progress(long step) override { progress_.update(step); }
+  void progress(long step) override { progress_.update(step, simulation_.time()); }
 
  private:
   cosserat::Simulation& simulation_;
@@ -252,9 +261,11 @@ int run(const RunOptions& options, int rank, int ranks) {
   Simulation& simulation = *simulation_owner;
   std::optional<long> restarted_from;
   std::optional<double> rest_peak;  // --until-rest's peak so far, when the checkpoint has it
+  double adaptive_scale = 1.0;
   if (!options.restart.empty()) {
     try {
-      restarted_from = read_checkpoint(options.restart, simulation, scene, &rest_peak);
+      restarted_from =
+          read_checkpoint(options.restart, simulation, scene, &rest_peak, &adaptive_scale);
     } catch (const CheckpointError& e) {
       if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
       return kExitBadInput;
@@ -270,7 +281,9 @@ int run(const RunOptions& options, int rank, int ranks) {
     if (continued)
       writer = std::make_unique<FrameWriter>(
           output, simulation.block(), *restarted_from, scene.text,
-          *restarted_from - *restarted_from % scene.output_every);
+          // Adaptive frames are at times, never after the checkpoint's state (step_loop.hpp).
+          scene.adaptive ? *restarted_from
+                         : *restarted_from - *restarted_from % scene.output_every);
     else
       writer = std::make_unique<FrameWriter>(output, simulation.block(), scene.text,
                                              integrator_name(scene.integrator), COSSERAT_VERSION,
@@ -286,10 +299,14 @@ int run(const RunOptions& options, int rank, int ranks) {
   const int threads = omp_get_max_threads();
   const bool on_terminal = !options.quiet && rank == 0 && isatty(STDERR_FILENO);
   if (!options.quiet && rank == 0) {
-    fmt::print("{}: {} x {} nodes, {} steps of {} s with {}, {} rank{} ({} x {} blocks) x {} "
-               "threads -> {}\n",
-               scene.title.empty() ? scene.name : scene.title, scene.m, scene.n, scene.steps,
-               scene.dt, integrator_name(scene.integrator), ranks, ranks == 1 ? "" : "s",
+    const std::string steps =
+        scene.adaptive
+            ? fmt::format("{} s in adaptive steps (at most {} s, safety {})", scene.duration,
+                          scene.adaptive->max, scene.adaptive->safety)
+            : fmt::format("{} steps of {} s", scene.steps, scene.dt);
+    fmt::print("{}: {} x {} nodes, {} with {}, {} rank{} ({} x {} blocks) x {} threads -> {}\n",
+               scene.title.empty() ? scene.name : scene.title, scene.m, scene.n, steps,
+               integrator_name(scene.integrator), ranks, ranks == 1 ? "" : "s",
                decomposition->parts_k(), decomposition->parts_l(), threads, output);
     if (restarted_from)
       fmt::print("restarted from {} at step {}\n", options.restart, *restarted_from);
@@ -300,11 +317,12 @@ int run(const RunOptions& options, int rank, int ranks) {
   if (!continued)
     writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions());
 
-  Progress progress(scene.steps, scene.dt, on_terminal);
+  Progress progress(simulation.step_index(), simulation.time(), scene.duration, on_terminal);
   RunObserver observer(simulation, scene, *writer, checkpoint, progress);
   const StepLoopResult loop = run_step_loop(
       simulation, scene,
-      StepLoopOptions{options.checkpoint_every, options.until_rest, rest_peak.value_or(0.0)},
+      StepLoopOptions{options.checkpoint_every, options.until_rest, rest_peak.value_or(0.0),
+                      adaptive_scale},
       observer);
   progress.finish();
 
@@ -321,11 +339,20 @@ int run(const RunOptions& options, int rank, int ranks) {
     if (rank == 0 && !failure->solver_failure) {
       const CflEstimate cfl =
           cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
-      fmt::print(stderr,
-                 "hint: this run's dt is {} s; the rest sheet's CFL estimate is {:.3g} s "
-                 "(docs/stability.md); `cosserat stable-dt {}` measures the largest stable "
-                 "step, and says when no step helps\n",
-                 scene.dt, cfl.dt, options.scene_path);
+      if (scene.adaptive)
+        fmt::print(stderr,
+                   "hint: adaptive steps went down to time.dt.min = {:.3g} s (the rest sheet's "
+                   "CFL estimate is {:.3g} s): a failure no step cures is a property of the "
+                   "model here, not of the integrator (docs/stability.md); `cosserat stable-dt "
+                   "{}` says whether any fixed step gets past it\n",
+                   scene.adaptive->min, cfl.dt, options.scene_path);
+      else
+        fmt::print(stderr,
+                   "hint: this run's dt is {} s; the rest sheet's CFL estimate is {:.3g} s "
+                   "(docs/stability.md); `cosserat stable-dt {}` measures the largest stable "
+                   "step, and says when no step helps; or leave time.dt out for adaptive "
+                   "steps\n",
+                   scene.dt, cfl.dt, options.scene_path);
       if (scene.energy_indefinite)
         fmt::print(stderr,
                    "hint: this material's stored energy is not positive definite (phi^2 >= 4 "
@@ -374,7 +401,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
   const auto status = bad_input(options.scene_path, rank, [&] {
     const Scene base = load_scene(options.scene_path, options.overrides);
     if (integrators.empty()) integrators.push_back(integrator_name(base.integrator));
-    duration = options.duration.value_or(static_cast<double>(base.steps) * base.dt);
+    duration = options.duration.value_or(base.duration);
     if (!(duration > 0.0))
       throw SceneError(fmt::format("{}: the simulated time must be > 0 (give --time T)",
                                    options.scene_path));
@@ -382,6 +409,9 @@ int stable_dt(const StableDtOptions& options, int rank) {
     for (const std::string& name : integrators) {
       std::vector<std::string> overrides = options.overrides;
       overrides.push_back(fmt::format("time.integrator=\"{}\"", name));
+      // Trials take fixed steps, which every integrator can; the search starts from the
+      // largest adaptive step.
+      if (base.adaptive) overrides.push_back(fmt::format("time.dt={}", base.dt));
       scenes.push_back(load_scene(options.scene_path, overrides));
     }
     Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));

@@ -1,6 +1,7 @@
 #include "cosserat/io/checkpoint.hpp"
 
 #include <filesystem>
+#include <limits>
 #include <system_error>
 #include <vector>
 
@@ -115,7 +116,8 @@ std::string checkpoint_path(const std::string& output_path) {
 }
 
 void write_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
-                      const std::string& version, std::optional<double> rest_peak) {
+                      const std::string& version, std::optional<double> rest_peak,
+                      std::optional<double> adaptive_scale) {
   const Block& b = simulation.block();
   const std::string partial = path + ".partial";
   {
@@ -130,6 +132,13 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
     file.write_attribute("step", std::int64_t{simulation.step_index()});
     file.write_attribute("time", simulation.time());
     if (rest_peak) file.write_attribute("peak_kinetic_energy", *rest_peak);
+    if (scene.adaptive) {
+      // Adaptive steps continue bitwise only from the same step history and roll-back bound.
+      file.write_attribute("last_dt", simulation.stepper().last_dt());
+      file.write_attribute("adaptive_scale", adaptive_scale.value_or(1.0));
+      for (const Stepper::StateScalar& x : simulation.stepper().state_scalars())
+        file.write_attribute(x.name, *x.value);
+    }
     const std::vector<hsize_t> shape{static_cast<hsize_t>(b.m), static_cast<hsize_t>(b.n), 3};
     for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
       const Handle dataset = create_dataset(file, "/" + f.name, H5T_IEEE_F64LE, shape);
@@ -155,7 +164,7 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
 }
 
 long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
-                     std::optional<double>* rest_peak) {
+                     std::optional<double>* rest_peak, double* adaptive_scale) {
   const Block& b = simulation.block();
   try {
     const hdf5::File file(path, b.comm, hdf5::File::Mode::read);
@@ -164,6 +173,11 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
     const long m = file.read_int_attribute("m"), n = file.read_int_attribute("n");
     const std::string integrator = file.read_string_attribute("integrator");
     const double dt = file.read_double_attribute("dt");
+    const bool adaptive = file.has_attribute("adaptive_scale");
+    if (adaptive != scene.adaptive.has_value())
+      throw CheckpointError(fmt::format(
+          "checkpoint '{}' was written with {} steps; this scene's steps are {}", path,
+          adaptive ? "adaptive" : "fixed", scene.adaptive ? "adaptive" : "fixed"));
     if (m != scene.m || n != scene.n || integrator != integrator_name(scene.integrator) ||
         dt != scene.dt)
       throw CheckpointError(fmt::format(
@@ -183,7 +197,19 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
       file.read_block(dataset.get(), *f.field, "read /" + f.name);
     }
     simulation.stepper().constraints().restore(read_constraints(file));
-    simulation.stepper().resume(step);
+    if (adaptive) {
+      const double time = file.read_double_attribute("time");
+      if (!(time >= 0.0 && time <= scene.duration))
+        throw CheckpointError(fmt::format("checkpoint '{}' is at t = {} s, outside this scene's "
+                                          "duration of {} s",
+                                          path, time, scene.duration));
+      for (const Stepper::StateScalar& x : simulation.stepper().state_scalars())
+        *x.value = file.read_double_attribute(x.name);
+      if (adaptive_scale != nullptr) *adaptive_scale = file.read_double_attribute("adaptive_scale");
+      simulation.stepper().resume(step, time, file.read_double_attribute("last_dt"));
+    } else {
+      simulation.stepper().resume(step);
+    }
     return step;
   } catch (const CheckpointError&) {
     throw;

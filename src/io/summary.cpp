@@ -58,7 +58,7 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   summary.parts_k = placement.parts_k;
   summary.parts_l = placement.parts_l;
   summary.integrator = integrator_name(scene.integrator);
-  summary.dt = scene.dt;
+  summary.dt = scene.adaptive ? std::nan("") : scene.dt;
   summary.steps = simulation.step_index();
   summary.sim_time = simulation.time();
   summary.wall_seconds = wall;
@@ -78,6 +78,7 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   summary.output = placement.output;
   summary.linear_solves = simulation.stepper().linear_solves();
   summary.rest = loop.rest;
+  summary.adaptive = loop.adaptive;
   return summary;
 }
 
@@ -101,6 +102,12 @@ std::string to_json(const RunSummary& s) {
     rest = fmt::format(R"({{"fraction": {}, "peak_kinetic_energy": {}, "step": {}}})",
                        json_number(r->fraction), json_number(r->peak_kinetic_energy),
                        r->step ? fmt::format("{}", *r->step) : "null");
+  }
+  std::string adaptive = "null";
+  if (const auto& a = s.adaptive) {
+    adaptive = fmt::format(R"({{"smallest_dt": {}, "largest_dt": {}, "rollbacks": {}}})",
+                           json_number(a->smallest_dt), json_number(a->largest_dt),
+                           a->rollbacks);
   }
   return fmt::format(
       R"({{
@@ -128,7 +135,8 @@ std::string to_json(const RunSummary& s) {
   "center_of_mass": [{}, {}, {}],
   "output": {},
   "linear_solves": {},
-  "rest": {}
+  "rest": {},
+  "adaptive": {}
 }}
 )",
       json_string(s.scene), s.m, s.n, s.ranks, s.threads, s.parts_k, s.parts_l,
@@ -136,7 +144,7 @@ std::string to_json(const RunSummary& s) {
       json_number(s.wall_seconds), json_number(s.node_steps_per_second),
       json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,
       json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
-      json_number(s.elastic_energy), json_number(s.gravitational_energy), json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest);
+      json_number(s.elastic_energy), json_number(s.gravitational_energy), json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest, adaptive);
 }
 
 void write_summary(const std::string& path, const RunSummary& summary) {

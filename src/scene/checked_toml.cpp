@@ -99,6 +99,12 @@ std::string Entry::string() const {
   return text->get();
 }
 
+bool Entry::boolean() const {
+  const auto* flag = node_->as_boolean();
+  if (flag == nullptr) fail(fmt::format("must be true or false, got {}", describe(*node_)));
+  return flag->get();
+}
+
 std::vector<Entry> Entry::elements(std::size_t size, std::string_view what) const {
   const auto* array = node_->as_array();
   if (array == nullptr || (size != 0 && array->size() != size)) {

@@ -54,6 +54,7 @@ class Entry {
   double number() const;
   long integer() const;
   std::string string() const;
+  bool boolean() const;
 
   // The elements of an array of `size` entries (any size when 0); `what` names the expected form.
   std::vector<Entry> elements(std::size_t size, std::string_view what) const;
@@ -63,6 +64,7 @@ class Entry {
   // A material tensor: one number (isotropic) or [t11, t12, t22].
   Sym2 tensor() const;
 
+  bool is_table() const { return node_->is_table(); }
   Table table() const;
 
   // The blocks of a [[block]] array, keyed block[0], block[1], ...

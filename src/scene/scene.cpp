@@ -23,6 +23,7 @@
 #include <string_view>
 
 #include "checked_toml.hpp"
+#include "cosserat/model/wave_speed.hpp"
 #include "overrides.hpp"
 
 namespace cosserat {
@@ -219,8 +220,106 @@ LinearSolver read_solver(const Table& solver) {
   return linear;
 }
 
+// time.dt a number: steps (or a duration) of that step, a frame every output_every steps (or
+// the nearest whole number of steps to output_dt), so that a scene written for adaptive steps
+// also runs with `--set time.dt=...`.
+void read_fixed_step(const Table& time, const Entry& dt, Scene& scene) {
+  scene.dt = positive(dt);
+  const auto steps = time.find("steps");
+  const auto duration = time.find("duration");
+  if (steps && duration) duration->fail("give time.steps or time.duration, not both");
+  if (duration) {
+    const double seconds = positive(*duration);
+    // Steps are counted in a long: a duration of more steps than that is not a run.
+    const double count = std::ceil(seconds / scene.dt - 1e-9);
+    if (!(count < 1e15)) {
+      duration->fail(fmt::format("{} s in steps of {} s is {:.3g} steps: too many", seconds,
+                                 scene.dt, count));
+    }
+    scene.steps = static_cast<long>(count);
+  } else {
+    scene.steps = integer_at_least(
+        time.require("steps", "an integer >= 0 (or time.duration in seconds)"), 0);
+  }
+  scene.duration = static_cast<double>(scene.steps) * scene.dt;
+  // About a hundred frames unless the scene says otherwise.
+  scene.output_every = std::max(1L, scene.steps / 100);
+  const auto every = time.find("output_every");
+  const auto output_dt = time.find("output_dt");
+  if (every && output_dt) output_dt->fail("give time.output_every or time.output_dt, not both");
+  if (every) scene.output_every = integer_at_least(*every, 1);
+  if (output_dt) {
+    const double frames = positive(*output_dt) / scene.dt;
+    scene.output_every = frames < 1e15 ? std::max(1L, std::lround(frames)) : std::max(1L, scene.steps);
+  }
+}
+
+// No time.dt, or time.dt = { adaptive = true, min, max, safety }: a duration and frames at fixed
+// simulated times (docs/stability.md, "Adaptive steps").
+void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene& scene) {
+  for (const char* fixed_only : {"steps", "output_every"}) {
+    if (const auto entry = time.find(fixed_only)) {
+      entry->fail(fmt::format(
+          "counts fixed steps, and this scene's steps are adaptive ({}); give time.duration and "
+          "time.output_dt in seconds, or a fixed step time.dt = <seconds>",
+          dt ? "time.dt is a table" : "it gives no time.dt"));
+    }
+  }
+  switch (scene.integrator) {
+    case Integrator::leapfrog:
+    case Integrator::verlet_lagged:
+    case Integrator::semi_implicit: {
+      const std::string why = fmt::format(
+          "the {} integrator assumes a constant step; adaptive steps work with verlet, "
+          "tc-verlet, symplectic-euler, euler, midpoint, rk4 and velocity-verlet",
+          integrator_name(scene.integrator));
+      if (dt) dt->fail(why);
+      time.missing("dt", "a fixed step in seconds: " + why);
+    }
+    default:
+      break;
+  }
+  scene.duration = positive(time.require("duration", "the simulated time in seconds"));
+  scene.output_dt = scene.duration / 100.0;
+  if (const auto output_dt = time.find("output_dt")) scene.output_dt = positive(*output_dt);
+  AdaptiveStep adaptive;
+  adaptive.max = scene.output_dt;
+  if (dt) {
+    dt->allow({"adaptive", "min", "max", "safety"});
+    const Entry flag = dt->require("adaptive", "true (a fixed step is a number: time.dt = 0.001)");
+    if (!flag.boolean()) {
+      flag.fail("a fixed step is a number (time.dt = 0.001); a table means adaptive = true");
+    }
+    if (const auto max = dt->find("max")) adaptive.max = positive(*max);
+    if (const auto safety = dt->find("safety")) {
+      adaptive.safety = positive(*safety);
+      if (adaptive.safety > 1.0) {
+        safety->fail(fmt::format("must be in (0, 1], a fraction of the stability estimate; "
+                                 "got {}", adaptive.safety));
+      }
+    }
+  }
+  // The rest sheet's CFL step sets the scale of the smallest step worth taking.
+  const CflEstimate cfl =
+      cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
+  adaptive.min = 1e-6 * std::min(adaptive.max, adaptive.safety * cfl.dt);
+  if (dt)
+    if (const auto min = dt->find("min")) {
+      adaptive.min = positive(*min);
+      if (adaptive.min > adaptive.max) {
+        min->fail(fmt::format("must be <= time.dt.max ({} s), got {}", adaptive.max,
+                              adaptive.min));
+      }
+    }
+  scene.dt = adaptive.max;
+  // Enough for the duration at the smallest step; a bound, not a schedule.
+  const double most = std::ceil(scene.duration / adaptive.min);
+  scene.steps = most < 9e18 ? static_cast<long>(most) : std::numeric_limits<long>::max();
+  scene.adaptive = adaptive;
+}
+
 void read_time(const Table& time, Scene& scene) {
-  time.allow({"integrator", "dt", "steps", "output_every", "solver"});
+  time.allow({"integrator", "dt", "steps", "duration", "output_every", "output_dt", "solver"});
   if (const auto entry = time.find("integrator")) {
     const std::string name = entry->string();
     const auto integrator = integrator_from_name(name);
@@ -246,12 +345,11 @@ void read_time(const Table& time, Scene& scene) {
           integrator_name(scene.integrator));
     }
   }
-  scene.dt = positive(time.require("dt", "a number > 0 (seconds)"));
-  scene.steps = integer_at_least(time.require("steps", "an integer >= 0"), 0);
-  // About a hundred frames unless the scene says otherwise.
-  scene.output_every = std::max(1L, scene.steps / 100);
-  if (const auto every = time.find("output_every")) {
-    scene.output_every = integer_at_least(*every, 1);
+  const auto dt = time.find("dt");
+  if (dt && !dt->is_table()) {
+    read_fixed_step(time, *dt, scene);
+  } else {
+    read_adaptive_step(time, dt ? std::optional(dt->table()) : std::nullopt, scene);
   }
 }
 
@@ -375,16 +473,33 @@ NodeSet read_node_set(const Table& block, const Scene& scene) {
 // ---------------------------------------------------------------------------------------------
 // Constraints (MODEL.md §4.1)
 
-// Inclusive step window; `end` defaults to the end of the run.
-template <typename Constraint>
-void read_window(const Table& block, Constraint& constraint) {
-  if (const auto start = block.find("start")) constraint.start = integer_at_least(*start, 0);
+// Inclusive windows in steps and in seconds; the ends default to the end of the run.
+Window read_window(const Table& block, const Scene& scene) {
+  Window window;
+  if (scene.adaptive) {
+    for (const char* in_steps : {"start", "end"})
+      if (const auto entry = block.find(in_steps)) {
+        entry->fail(fmt::format("counts steps, and this scene's steps are adaptive; give "
+                                "{}_time in seconds",
+                                in_steps));
+      }
+  }
+  if (const auto start = block.find("start")) window.start = integer_at_least(*start, 0);
   if (const auto end = block.find("end")) {
-    constraint.end = integer_at_least(*end, 0);
-    if (constraint.start > constraint.end) {
-      end->fail(fmt::format("must be >= start ({}), got {}", constraint.start, constraint.end));
+    window.end = integer_at_least(*end, 0);
+    if (window.start > window.end) {
+      end->fail(fmt::format("must be >= start ({}), got {}", window.start, window.end));
     }
   }
+  if (const auto start = block.find("start_time")) window.start_time = non_negative(*start);
+  if (const auto end = block.find("end_time")) {
+    window.end_time = non_negative(*end);
+    if (window.start_time > window.end_time) {
+      end->fail(fmt::format("must be >= start_time ({} s), got {}", window.start_time,
+                            window.end_time));
+    }
+  }
+  return window;
 }
 
 std::array<bool, 3> held_axes(const Entry& entry) {
@@ -404,21 +519,21 @@ std::array<bool, 3> held_axes(const Entry& entry) {
 }
 
 Fix read_fix(const Table& block, const Scene& scene) {
-  block.allow({"nodes", "region", "axes", "start", "end"});
+  block.allow({"nodes", "region", "axes", "start", "end", "start_time", "end_time"});
   Fix fix;
   fix.nodes = read_node_set(block, scene);
   if (const auto axes = block.find("axes")) fix.axes = held_axes(*axes);
-  read_window(block, fix);
+  fix.window = read_window(block, scene);
   return fix;
 }
 
 Load read_load(const Table& block, const Scene& scene) {
-  block.allow({"nodes", "region", "force", "start", "end"});
+  block.allow({"nodes", "region", "force", "start", "end", "start_time", "end_time"});
   Load load;
   load.nodes = read_node_set(block, scene);
   load.force =
       block.require("force", "an array of 3 numbers [x, y, z] in newtons per node").vector3();
-  read_window(block, load);
+  load.window = read_window(block, scene);
   return load;
 }
 
@@ -454,7 +569,7 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   if (const auto environment = root.find_table("environment")) {
     read_environment(*environment, scene);
   }
-  read_time(root.require_table("time", "a [time] table with dt and steps"), scene);
+  read_time(root.require_table("time", "a [time] table with dt and steps, or a duration"), scene);
   if (const auto fixes = root.find("fix")) {
     for (const auto& block : fixes->tables("fix")) scene.fixes.push_back(read_fix(block, scene));
   }

@@ -6,24 +6,24 @@ namespace cosserat {
 
 Constraints::Constraints(const std::vector<Fix>& fixes, const Block& block) {
   // Several fixes may hold one node: gather them per node, in a fixed (l, k) order.
-  std::map<std::pair<int, int>, std::vector<Window>> by_node;
+  std::map<std::pair<int, int>, std::vector<AxesWindow>> by_node;
   for (const Fix& fix : fixes) {
     std::uint8_t axes = 0;
     for (int c = 0; c < 3; ++c)
       if (fix.axes[static_cast<std::size_t>(c)]) axes |= static_cast<std::uint8_t>(1u << c);
     for (const NodeIndex& node : fix.nodes.nodes)
       if (block.owns(node.k, node.l))
-        by_node[{node.l, node.k}].push_back(Window{axes, fix.start, fix.end});
+        by_node[{node.l, node.k}].push_back(AxesWindow{axes, fix.window});
   }
   for (auto& [lk, windows] : by_node)
     nodes_.push_back(HeldNode{lk.second, lk.first, std::move(windows), 0, {}});
 }
 
-void Constraints::begin_step(long step, const Field<Vec3>& positions) {
+void Constraints::begin_step(long step, double time, const Field<Vec3>& positions) {
   for (HeldNode& node : nodes_) {
     std::uint8_t held = 0;
-    for (const Window& w : node.windows)
-      if (w.start <= step && step <= w.end) held |= w.axes;
+    for (const AxesWindow& w : node.windows)
+      if (w.window.contains(step, time)) held |= w.axes;
     const std::uint8_t newly_held = held & static_cast<std::uint8_t>(~node.held);
     const Vec3 now = positions(node.k, node.l);
     for (int c = 0; c < 3; ++c)

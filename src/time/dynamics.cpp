@@ -26,7 +26,7 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
   for (const Load& load : scene.loads)
     for (const NodeIndex& node : load.nodes.nodes)
       if (block.owns(node.k, node.l))
-        loads_.push_back(PointLoad{node.k, node.l, load.force, load.start, load.end});
+        loads_.push_back(PointLoad{node.k, node.l, load.force, load.window});
   if (discretisation_ == Discretisation::flux)
     flux_.emplace(block, scene.h1(), scene.h2(),
                   flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
@@ -76,7 +76,7 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
     }
   // Point loads are newtons on the node's lumped mass μ h1 h2 (MODEL.md §1).
   for (const PointLoad& load : loads_)
-    if (load.start <= step && step <= load.end)
+    if (load.window.contains(step, time_))
       a(load.k, load.l) += (inverse_density / h1h2_) * load.force;
   return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
 }

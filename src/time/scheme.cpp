@@ -20,7 +20,7 @@ void Scheme::hold(Field<Vec3>& r, Field<Vec3>& v) const {
 }
 
 void Scheme::begin(Field<Vec3> velocities) {
-  context_.constraints.begin_step(0, positions_);
+  context_.constraints.begin_step(0, 0.0, positions_);
   hold(positions_, velocities);
   context_.halo.exchange(positions_);
   start(std::move(velocities));

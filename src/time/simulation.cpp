@@ -100,4 +100,30 @@ Diagnostics Simulation::diagnostics() {
   return d;
 }
 
+StateMeasures Simulation::state_measures() {
+  const Block& b = block_;
+  const Field<Vec3>& r = stepper_.positions();
+  const Field<Vec3>& v = stepper_.velocities();
+  const double inverse_h1_2 = 1.0 / (scene_->h1() * scene_->h1());
+  const double inverse_h2_2 = 1.0 / (scene_->h2() * scene_->h2());
+  // Each edge is read by the rank and thread that own its first node, and maxima are exact, so
+  // the result is the same for any decomposition.
+  double stretch2 = 0.0, speed2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : stretch2, speed2)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      const Vec3 p = r(k, l);
+      if (k + 1 < b.m) {
+        const Vec3 e = r(k + 1, l) - p;
+        stretch2 = std::max(stretch2, dot(e, e) * inverse_h1_2);
+      }
+      if (l + 1 < b.n) {
+        const Vec3 e = r(k, l + 1) - p;
+        stretch2 = std::max(stretch2, dot(e, e) * inverse_h2_2);
+      }
+      speed2 = std::max(speed2, dot(v(k, l), v(k, l)));
+    }
+  return StateMeasures{global_max(stretch2, b.comm), std::sqrt(global_max(speed2, b.comm))};
+}
+
 }  // namespace cosserat

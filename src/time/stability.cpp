@@ -14,9 +14,12 @@ namespace cosserat {
 StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Comm comm,
                          const SchemeFactory& make) {
   Scene trial_scene = scene;
+  // Every trial takes fixed steps, whatever the scene's own.
+  trial_scene.adaptive.reset();
   trial_scene.dt = dt;
   // Checked by largest_stable_step: a step count that fits a long.
   trial_scene.steps = static_cast<long>(std::ceil(duration / dt - 1e-9));
+  trial_scene.duration = static_cast<double>(trial_scene.steps) * dt;
   const auto start = std::chrono::steady_clock::now();
   Simulation simulation(trial_scene, comm, make);
   StabilityTrial trial;

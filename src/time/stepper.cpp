@@ -1,5 +1,6 @@
 #include "cosserat/time/stepper.hpp"
 
+#include "cosserat/time/adaptive_step.hpp"
 #include "cosserat/time/failure_diagnosis.hpp"
 
 #include <algorithm>
@@ -9,41 +10,75 @@
 
 namespace cosserat {
 
+namespace {
+// The scene's step, or the first adaptive one: what the rest sheet at its initial velocity
+// allows. The schemes build the history of their first step with it.
+double first_step(const Scene& scene) {
+  if (!scene.adaptive) return scene.dt;
+  const StateMeasures rest{1.0, std::sqrt(dot(scene.initial_velocity, scene.initial_velocity))};
+  const AdaptiveStep& a = *scene.adaptive;
+  return std::max(a.min, std::min(a.max, a.safety * stability_estimate(scene, rest)));
+}
+}  // namespace
+
 Stepper::Stepper(const Scene& scene, const Decomposition& decomposition, const Block& block,
                  Halo& halo, Dynamics& dynamics, const Field<Vec3>& positions,
                  Field<Vec3> velocities, const SchemeFactory& make)
     : block_(&block),
+      dynamics_(&dynamics),
       constraints_(scene.fixes, block),
-      dt_(scene.dt),
+      dt_(first_step(scene)),
       h1_(scene.h1()),
       h2_(scene.h2()),
       max_move_(0.5 * std::min(scene.h1(), scene.h2())) {
-  const StepContext context{block, halo, dynamics, constraints_, scene.dt};
+  const StepContext context{block, halo, dynamics, constraints_, dt_};
   scheme_ = make(SchemeSetup{scene, decomposition, context, positions});
   scheme_->begin(std::move(velocities));
 }
 
 std::optional<Instability> Stepper::step() {
-  constraints_.begin_step(step_, scheme_->positions());
+  return step(dt_, static_cast<double>(step_ + 1) * dt_);
+}
+
+std::optional<Instability> Stepper::step(double dt, double end_time) {
+  scheme_->set_step(dt, time_);
+  dynamics_->set_time(time_);
+  constraints_.begin_step(step_, time_, scheme_->positions());
   if (auto solver_failure = scheme_->advance(step_)) {
-    return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, -1, -1, false,
-                       std::move(solver_failure), {}};
+    return Instability{step_ + 1, end_time, -1, -1, false, std::move(solver_failure), {}};
   }
   if (!actions_.empty()) {
-    ProposedStep proposed{step_ + 1, dt_, scheme_->positions(), scheme_->next_positions(),
+    ProposedStep proposed{step_ + 1, dt, scheme_->positions(), scheme_->next_positions(),
                           scheme_->next_velocities()};
     for (const auto& action : actions_) action->apply(proposed);
   }
-  if (auto failure = check(scheme_->next_positions())) return failure;
+  if (auto failure = check(scheme_->next_positions(), end_time)) return failure;
   scheme_->accept();
   ++step_;
-  time_ = static_cast<double>(step_) * dt_;
+  dt_ = dt;
+  time_ = end_time;
   return std::nullopt;
+}
+
+Stepper::Snapshot Stepper::snapshot() {
+  Snapshot s{step_, time_, dt_, {}, {}, constraints_.state()};
+  for (const StateField& f : scheme_->state_fields()) s.fields.push_back(*f.field);
+  for (const StateScalar& x : scheme_->state_scalars()) s.scalars.push_back(*x.value);
+  return s;
+}
+
+void Stepper::restore(const Snapshot& s) {
+  const std::vector<StateField> fields = scheme_->state_fields();
+  for (std::size_t i = 0; i < fields.size(); ++i) *fields[i].field = s.fields[i];
+  const std::vector<StateScalar> scalars = scheme_->state_scalars();
+  for (std::size_t i = 0; i < scalars.size(); ++i) *scalars[i].value = s.scalars[i];
+  constraints_.restore(s.constraints);
+  resume(s.step, s.time, s.last_dt);
 }
 
 // MODEL.md §4.2: a position that is not finite, or a node that moved more than half a grid
 // spacing. The first such node in (l, k) order is reported, the same for any thread count.
-std::optional<Instability> Stepper::check(const Field<Vec3>& next) const {
+std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_time) const {
   const Block& b = *block_;
   const Field<Vec3>& r = scheme_->positions();
   const double limit2 = max_move_ * max_move_;
@@ -80,13 +115,16 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next) const {
   int any_reason = reason;
   MPI_Allreduce(&reason, &any_reason, 1, MPI_INT, MPI_MAX, b.comm);
   const int k = static_cast<int>(global % b.m), l = static_cast<int>(global / b.m);
-  return Instability{step_ + 1, static_cast<double>(step_ + 1) * dt_, k, l, any_reason != 0,
+  return Instability{step_ + 1, end_time, k, l, any_reason != 0,
                      std::nullopt, diagnose_failure(r, k, l, h1_, h2_)};
 }
 
-void Stepper::resume(long step) {
+void Stepper::resume(long step) { resume(step, static_cast<double>(step) * dt_, dt_); }
+
+void Stepper::resume(long step, double time, double last_dt) {
   step_ = step;
-  time_ = static_cast<double>(step_) * dt_;
+  time_ = time;
+  dt_ = last_dt;
   scheme_->resume();
 }
 

@@ -150,6 +150,8 @@ std::optional<std::string> VelocityVerlet::advance(long step) {
   });
   hold(next_positions_, predicted_velocity_);
   context_.halo.exchange(next_positions_);
+  // a⁺ belongs to the end of the step, where load windows in seconds are told.
+  context_.dynamics.set_time(context_.time + dt);
   context_.dynamics.acceleration(next_positions_, predicted_velocity_, step + 1,
                                  next_acceleration_, normals());
   for_owned(context_.block, [&](int k, int l) {

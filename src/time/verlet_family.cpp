@@ -44,23 +44,25 @@ std::optional<std::string> VerletFamily::propose(long step) {
   return std::nullopt;
 }
 
-// verlet and tc-verlet: r⁺ = r + (r − r⁻) Δtₙ/Δtₙ₋₁ + Δtₙ² a with the velocity terms at the
-// centre, v = (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁), solved in closed form (MODEL.md §4). With a constant
-// step both are the plain central-difference Verlet.
+// verlet and tc-verlet: r⁺ = r + (r − r⁻) Δtₙ/Δtₙ₋₁ + Δtₙ (Δtₙ + Δtₙ₋₁)/2 a, the form that is
+// consistent on a non-uniform time grid (MODEL.md §4 publishes Δtₙ² a, first order when the
+// step changes; docs/stability.md), with the velocity terms at the centre,
+// v = (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁), solved in closed form. With a constant step both are the plain
+// central-difference Verlet, bit for bit: (Δt + Δt)/2 is Δt exactly.
 void VerletFamily::centred_step(long step) {
   context_.constraints.hold_positions(previous_positions_);  // a node held from now on starts at rest
   Field<Vec3>* n_field = normals();
   const VelocityTerms terms =
       context_.dynamics.free_acceleration(positions_, step, acceleration_, n_field);
   const double dt = context_.dt;
-  const double dt2 = dt * dt;
+  const double weight = dt * ((dt + dt_previous_) * 0.5);
   const double ratio = dt / dt_previous_;
   const double span = dt + dt_previous_;
-  const double c = terms.damping * dt2 / span;
-  const double d = terms.fluid * dt2 / span;
+  const double c = terms.damping * weight / span;
+  const double d = terms.fluid * weight / span;
   for_owned(context_.block, [&](int k, int l) {
     const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
-    Vec3 rhs = r + ratio * (r - rp) + dt2 * acceleration_(k, l) + c * rp;
+    Vec3 rhs = r + ratio * (r - rp) + weight * acceleration_(k, l) + c * rp;
     if (d > 0.0) {
       const Vec3 n = (*n_field)(k, l);
       rhs += (d * dot(n, rp)) * n;

@@ -13,6 +13,7 @@
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
+#include "cosserat/time/step_loop.hpp"
 #include "mpi_support.hpp"
 #include "support/dataset_bytes.hpp"
 #include "support/sheets.hpp"
@@ -166,6 +167,60 @@ TEST_F(Output, OfPRanksReadsBackEqualToOneRank) {
     }
   MPI_Bcast(&equal, 1, MPI_INT, 0, MPI_COMM_WORLD);
   EXPECT_TRUE(equal) << "P = " << world_size();
+}
+
+// Writes the first checkpoint the loop asks for and no other, with what the loop carries; with
+// no path, none.
+class FirstCheckpoint : public StepObserver {
+ public:
+  FirstCheckpoint(Simulation& simulation, const Scene& scene, std::string path)
+      : simulation_(simulation), scene_(scene), path_(std::move(path)) {}
+  void frame() override {}
+  void checkpoint(const LoopCarry& carry) override {
+    if (written_ || path_.empty()) return;
+    write_checkpoint(path_, simulation_, scene_, "test", std::nullopt, carry.adaptive_scale);
+    written_ = true;
+  }
+  void progress(long) override {}
+
+ private:
+  Simulation& simulation_;
+  const Scene& scene_;
+  std::string path_;
+  bool written_ = false;
+};
+
+// Adaptive steps restart bitwise: the checkpoint holds the last step, tc-verlet's previous step
+// and what roll-backs left of the estimate, and the restarted run holds the same states to roll
+// back to. Checkpoints every 150 steps, the first kept; restarted on another split.
+TEST_F(Restart, AdaptiveStepsContinueBitwise) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
+    const Scene scene = testing::rolling_back_scene(integrator);
+    Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
+    StepLoopOptions options;
+    options.checkpoint_every = 150;
+    // The same schedule: a checkpoint is also where roll-backs stop.
+    FirstCheckpoint none(uninterrupted, scene, "");
+    const StepLoopResult expected = run_step_loop(uninterrupted, scene, options, none);
+    ASSERT_FALSE(expected.failure);
+    EXPECT_GE(expected.adaptive->rollbacks, 1);
+
+    Simulation first(scene, MPI_COMM_WORLD, any_scheme);
+    FirstCheckpoint keep(first, scene, checkpoint());
+    ASSERT_FALSE(run_step_loop(first, scene, options, keep).failure);
+
+    const auto splits = all_splits(scene.m, scene.n, world_size());
+    Simulation restarted(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
+    double scale = 0.0;
+    EXPECT_EQ(read_checkpoint(checkpoint(), restarted, scene, nullptr, &scale), 150);
+    options.adaptive_scale = scale;
+    FirstCheckpoint ignore(restarted, scene, "");
+    ASSERT_FALSE(run_step_loop(restarted, scene, options, ignore).failure);
+    EXPECT_EQ(restarted.time(), uninterrupted.time());
+    EXPECT_EQ(restarted.step_index(), uninterrupted.step_index()) << integrator_name(integrator);
+    EXPECT_EQ(differing_nodes(restarted.positions(), uninterrupted.positions()), 0)
+        << integrator_name(integrator);
+  }
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "cosserat/grid/halo.hpp"
 #include "cosserat/model/cosserat_energy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/time/step_loop.hpp"
 #include "mpi_support.hpp"
 #include "support/sheets.hpp"
 
@@ -166,6 +167,38 @@ TEST(DecompositionInvariance, S2CapeFollowsTheOneBlockTrajectory) {
       EXPECT_EQ(a.area_ratio, b.area_ratio);
       EXPECT_NEAR(a.kinetic_energy, b.kinetic_energy, 1e-12 * b.kinetic_energy);
     }
+}
+
+// An observer of nothing: the adaptive step loop's choices alone are compared.
+class Silent : public StepObserver {
+ public:
+  void frame() override {}
+  void checkpoint(const LoopCarry&) override {}
+  void progress(long) override {}
+};
+
+// Adaptive steps choose each step from global maxima: the same steps, the same roll-back and the
+// same trajectory, bitwise, on every split, for a scheme of each state kind.
+TEST(DecompositionInvariance, AdaptiveStepsAndTheirRollBacksFollowTheOneBlockRun) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::rk4}) {
+    const Scene scene = testing::rolling_back_scene(integrator);
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+    Silent silent;
+    const StepLoopResult expected = run_step_loop(reference, scene, {}, silent);
+    ASSERT_FALSE(expected.failure);
+    ASSERT_TRUE(expected.adaptive);
+    EXPECT_GE(expected.adaptive->rollbacks, 1) << integrator_name(integrator);
+    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+      const StepLoopResult result = run_step_loop(sim, scene, {}, silent);
+      ASSERT_FALSE(result.failure);
+      EXPECT_EQ(sim.step_index(), reference.step_index()) << split_name(d);
+      EXPECT_EQ(result.adaptive->rollbacks, expected.adaptive->rollbacks) << split_name(d);
+      EXPECT_EQ(result.adaptive->smallest_dt, expected.adaptive->smallest_dt) << split_name(d);
+      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+          << integrator_name(integrator) << ", split " << split_name(d);
+    }
+  }
 }
 
 }  // namespace

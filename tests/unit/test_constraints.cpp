@@ -36,8 +36,8 @@ TEST(Loads, ActOnlyInTheirWindowAndFixedWins) {
   Load load;
   load.nodes.nodes = {{5, 5}, {0, 0}};
   load.force = {0.0, 0.5, 0.0};
-  load.start = 100;
-  load.end = 200;
+  load.window.start = 100;
+  load.window.end = 200;
   scene.loads.push_back(load);
   scene.fixes.push_back(testing::fix_nodes({{0, 0}}));
   Simulation sim(scene, MPI_COMM_SELF);
@@ -58,8 +58,8 @@ TEST_P(Schemes, FixHoldsTheValueItFindsAlongItsAxes) {
   scene.gravity = {1.0, -9.8, 0.0};
   Fix fix = testing::fix_nodes({{2, 3}});
   fix.axes = {false, true, false};  // "y"
-  fix.start = 50;
-  fix.end = 150;
+  fix.window.start = 50;
+  fix.window.end = 150;
   scene.fixes.push_back(fix);
   Simulation sim(scene, MPI_COMM_SELF);
   ASSERT_TRUE(testing::advance(sim, 50));

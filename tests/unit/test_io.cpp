@@ -273,9 +273,10 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
       "restarted_from", "status",
       "unstable_step", "area_ratio",    "max_speed",      "kinetic_energy",
       "elastic_energy", "gravitational_energy",
-      "center_of_mass", "output",        "linear_solves",  "rest"};
+      "center_of_mass", "output",        "linear_solves",  "rest",          "adaptive"};
   EXPECT_EQ(keys, expected);
   EXPECT_NE(json.find(R"("linear_solves": null,)"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("adaptive": null)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("grid": [32, 48])"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("restarted_from": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("dt": 0.0001,)"), std::string::npos) << json;

@@ -156,12 +156,12 @@ end = 7
   ASSERT_EQ(scene.fixes.size(), 1u);
   EXPECT_EQ(scene.fixes[0].nodes.nodes, (std::vector<NodeIndex>{{0, 0}, {0, 11}}));
   EXPECT_EQ(scene.fixes[0].axes, (std::array<bool, 3>{true, false, true}));
-  EXPECT_EQ(scene.fixes[0].start, 3);
-  EXPECT_EQ(scene.fixes[0].end, 20001);
+  EXPECT_EQ(scene.fixes[0].window.start, 3);
+  EXPECT_EQ(scene.fixes[0].window.end, 20001);
   ASSERT_EQ(scene.loads.size(), 1u);
   EXPECT_EQ(scene.loads[0].force.z, -0.5);
-  EXPECT_EQ(scene.loads[0].start, 0);
-  EXPECT_EQ(scene.loads[0].end, 7);
+  EXPECT_EQ(scene.loads[0].window.start, 0);
+  EXPECT_EQ(scene.loads[0].window.end, 7);
 }
 
 TEST(Scene, FixDefaultsHoldEveryAxisForTheWholeRun) {
@@ -169,8 +169,8 @@ TEST(Scene, FixDefaultsHoldEveryAxisForTheWholeRun) {
   text.tail = "[[fix]]\nnodes = [[1, 1]]\n";
   const Fix fix = parse(text).fixes.at(0);
   EXPECT_EQ(fix.axes, (std::array<bool, 3>{true, true, true}));
-  EXPECT_EQ(fix.start, 0);
-  EXPECT_EQ(fix.end, std::numeric_limits<long>::max());
+  EXPECT_EQ(fix.window.start, 0);
+  EXPECT_EQ(fix.window.end, std::numeric_limits<long>::max());
 }
 
 TEST(Scene, PresetGivesEverythingAndScalesMassToTheSheet) {
@@ -774,7 +774,7 @@ TEST(ShippedScenes, CompressionLoadsAreTwentyHOneHTwoNewtons) {
   ASSERT_EQ(scene.loads.size(), 40u);
   const double area = scene.h1() * scene.h2();
   for (const auto& load : scene.loads) {
-    const double per_area = load.start == 0 ? 20.0 : 5.0;
+    const double per_area = load.window.start == 0 ? 20.0 : 5.0;
     EXPECT_EQ(load.force.y, 0.0);
     EXPECT_NEAR(std::abs(load.force.x), per_area * area, 1e-15);
     EXPECT_NEAR(std::abs(load.force.z), per_area * area, 1e-15);

@@ -26,12 +26,12 @@ Scene busy_sheet(Integrator scheme) {
   scene.initial_velocity = {0.2, 0.5, -0.1};
   scene.fixes.push_back(testing::fix_nodes({{0, 0}}));
   Fix later = testing::fix_nodes({{8, 6}, {4, 3}});
-  later.start = 5;
+  later.window.start = 5;
   scene.fixes.push_back(later);
   Load load;
   load.nodes.nodes = {{6, 2}};
   load.force = {0.3, 0.2, -0.1};
-  load.end = 20;
+  load.window.end = 20;
   scene.loads.push_back(load);
   scene.dt = 2e-3;
   return scene;

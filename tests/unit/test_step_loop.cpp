@@ -34,7 +34,7 @@ class Recorder : public StepObserver {
  public:
   explicit Recorder(const Simulation& simulation) : simulation_(simulation) {}
   void frame() override { events.push_back({"frame", simulation_.step_index()}); }
-  void checkpoint(const std::optional<RestSummary>&) override { events.push_back({"checkpoint", simulation_.step_index()}); }
+  void checkpoint(const LoopCarry&) override { events.push_back({"checkpoint", simulation_.step_index()}); }
   void progress(long step) override {
     EXPECT_EQ(step, simulation_.step_index());
     events.push_back({"progress", step});

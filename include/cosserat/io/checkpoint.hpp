@@ -24,15 +24,19 @@ std::string checkpoint_path(const std::string& output_path);
 // Writes the state of `simulation` to `path`: first to `path`.partial, renamed over `path` only
 // once complete and closed, so a run killed while writing leaves the previous checkpoint
 // valid. Collective. Throws std::runtime_error on I/O failure. `rest_peak`: the peak kinetic
-// energy so far of a run with --until-rest, which its restart must continue from.
+// energy so far of a run with --until-rest, which its restart must continue from;
+// `adaptive_scale`: what roll-backs left of adaptive steps' estimate (docs/stability.md).
 void write_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
-                      const std::string& version, std::optional<double> rest_peak = {});
+                      const std::string& version, std::optional<double> rest_peak = {},
+                      std::optional<double> adaptive_scale = {});
 
 // Loads a checkpoint into `simulation`, built for `scene` on any decomposition, and returns its
 // step. Throws CheckpointError if the file cannot be read as a checkpoint or was written for a
 // different grid, integrator or time step. Collective.
-// With `rest_peak`, also the peak kinetic energy the checkpoint carries (empty if none).
+// With `rest_peak`, also the peak kinetic energy the checkpoint carries (empty if none); with
+// `adaptive_scale`, what roll-backs left of adaptive steps' estimate.
 long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
-                     std::optional<double>* rest_peak = nullptr);
+                     std::optional<double>* rest_peak = nullptr,
+                     double* adaptive_scale = nullptr);
 
 }  // namespace cosserat

@@ -42,6 +42,7 @@ struct RunSummary {
   std::string output;  // the HDF5 file written
   std::optional<LinearSolveStats> linear_solves;  // semi-implicit only
   std::optional<RestSummary> rest;                  // with --until-rest only
+  std::optional<AdaptiveSummary> adaptive;          // with adaptive steps only (dt is null)
 };
 
 // How a run was laid out and where it wrote, beside what its scene and step loop say.

@@ -34,19 +34,38 @@ struct NodeSet {
   std::vector<NodeIndex> nodes;
 };
 
-// Step windows are inclusive: a constraint acts during step s when start <= s <= end.
+// When a fix or load acts, both bounds inclusive: during the step from step s at time t when
+// start <= s <= end and start_time <= t <= end_time. A fixed step may give either; adaptive
+// steps only the times, since there the step index depends on the steps taken.
+struct Window {
+  long start = 0;
+  long end = std::numeric_limits<long>::max();
+  double start_time = 0.0;
+  double end_time = std::numeric_limits<double>::infinity();
+
+  bool contains(long step, double time) const {
+    return start <= step && step <= end && start_time <= time && time <= end_time;
+  }
+};
+
 struct Fix {
   NodeSet nodes;
   std::array<bool, 3> axes{true, true, true};
-  long start = 0;
-  long end = std::numeric_limits<long>::max();
+  Window window;
 };
 
 struct Load {
   NodeSet nodes;
   Vec3 force;  // newtons on each node (MODEL.md §1)
-  long start = 0;
-  long end = std::numeric_limits<long>::max();
+  Window window;
+};
+
+// time.dt = { adaptive = true, ... }, or no time.dt: the step follows the stability estimate of
+// the current state (docs/stability.md, "Adaptive steps").
+struct AdaptiveStep {
+  double min = 0.0;     // s; a run that needs a smaller step is unstable (exit 3)
+  double max = 0.0;     // s
+  double safety = 0.5;  // the fraction of the estimate taken
 };
 
 struct Fluid {
@@ -95,9 +114,14 @@ struct Scene {
 
   // [time]
   Integrator integrator = Integrator::verlet;
+  // With a fixed step: dt, steps and output_every, duration = steps x dt. With adaptive steps:
+  // duration and output_dt; dt is the first step's bound, steps the most a run may take.
   double dt = 0.0;
   long steps = 0;
   long output_every = 1;  // write a frame every N steps (the last step always)
+  std::optional<AdaptiveStep> adaptive;
+  double duration = 0.0;   // simulated seconds
+  double output_dt = 0.0;  // adaptive: a frame every output_dt simulated seconds (and the last)
   LinearSolver solver;
 
   std::vector<Fix> fixes;

@@ -1,5 +1,5 @@
 #pragma once
-// Fixed nodes with axis masks and step windows (MODEL.md §4.1), for the nodes this block owns.
+// Fixed nodes with axis masks and windows in steps and seconds (MODEL.md §4.1), for the nodes this block owns.
 
 #include <cstdint>
 #include <vector>
@@ -14,9 +14,9 @@ class Constraints {
  public:
   Constraints(const std::vector<Fix>& fixes, const Block& block);
 
-  // Switches the fixes acting during `step` on and off. A component that becomes held keeps
-  // the value it has now (MODEL.md §4.1), not its rest value.
-  void begin_step(long step, const Field<Vec3>& positions);
+  // Switches the fixes acting during `step`, which starts at `time`, on and off. A component
+  // that becomes held keeps the value it has now (MODEL.md §4.1), not its rest value.
+  void begin_step(long step, double time, const Field<Vec3>& positions);
 
   // Held components back to their held value / to zero velocity.
   void hold_positions(Field<Vec3>& positions) const;
@@ -36,13 +36,13 @@ class Constraints {
   void restore(const std::vector<NodeState>& states);
 
  private:
-  struct Window {
+  struct AxesWindow {
     std::uint8_t axes;  // bit c set: component c held
-    long start, end;
+    Window window;
   };
   struct HeldNode {
     int k, l;
-    std::vector<Window> windows;
+    std::vector<AxesWindow> windows;
     std::uint8_t held = 0;
     Vec3 value;
   };

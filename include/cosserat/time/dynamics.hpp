@@ -38,6 +38,10 @@ class Dynamics {
   void acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step, Field<Vec3>& a,
                     Field<Vec3>* normals);
 
+  // The time at which the step the next evaluations belong to starts: load windows in seconds
+  // are told by it, as those in steps are by `step`.
+  void set_time(double time) { time_ = time; }
+
   bool has_fluid() const { return fluid_.has_value(); }
   // The stored energy E of MODEL.md §2.5 (J), a global sum; reads the ghosts of r. For the
   // flux form too, whose force is not its gradient: there it shows what the discretisation
@@ -56,7 +60,7 @@ class Dynamics {
   struct PointLoad {
     int k, l;
     Vec3 force;
-    long start, end;
+    Window window;
   };
 
   const Block* block_;
@@ -73,6 +77,7 @@ class Dynamics {
   std::optional<Fluid> fluid_;
   std::vector<PointLoad> loads_;
   bool needs_area_;
+  double time_ = 0.0;
 };
 
 }  // namespace cosserat

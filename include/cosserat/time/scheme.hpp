@@ -36,6 +36,7 @@ struct StepContext {
   Dynamics& dynamics;
   Constraints& constraints;
   double dt;
+  double time = 0.0;  // at the start of the step
 };
 
 class Scheme {
@@ -44,6 +45,11 @@ class Scheme {
   struct StateField {
     std::string name;
     Field<Vec3>* field;
+  };
+  // A number that carries state the same way (tc-verlet's previous step).
+  struct StateScalar {
+    std::string name;
+    double* value;
   };
 
   Scheme(const StepContext& context, const Field<Vec3>& positions);
@@ -76,6 +82,14 @@ class Scheme {
 
   // Together with the step index and the constraints' state, all a restart needs.
   virtual std::vector<StateField> state_fields() = 0;
+  virtual std::vector<StateScalar> state_scalars() { return {}; }
+
+  // The next step's size and start time: a fixed step sets them once, adaptive steps before
+  // every step.
+  void set_step(double dt, double time) {
+    context_.dt = dt;
+    context_.time = time;
+  }
 
   // The semi-implicit baseline's linear solves; nothing for the explicit schemes.
   virtual std::optional<LinearSolveStats> linear_solves() const { return std::nullopt; }
@@ -113,6 +127,7 @@ class VerletFamily : public Scheme {
   // The backward difference (r − r⁻)/Δt: the velocity half a step back.
   const Field<Vec3>& velocities() override;
   std::vector<StateField> state_fields() override;
+  std::vector<StateScalar> state_scalars() override { return {{"dt_previous", &dt_previous_}}; }
 
  protected:
   void start(Field<Vec3> velocities) override;
@@ -122,7 +137,7 @@ class VerletFamily : public Scheme {
   void state_changed() override { velocities_current_ = false; }
 
   Field<Vec3> previous_positions_;  // rⁿ⁻¹
-  double dt_previous_;              // Δt_{n−1} of tc-verlet; the scene's step is constant
+  double dt_previous_;              // Δtₙ₋₁; equal to Δtₙ with a fixed step
 
  private:
   void centred_step(long step);

@@ -10,6 +10,7 @@
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/halo.hpp"
 #include "cosserat/scene/scene.hpp"
+#include "cosserat/time/adaptive_step.hpp"
 #include "cosserat/time/dynamics.hpp"
 #include "cosserat/time/stepper.hpp"
 
@@ -54,6 +55,8 @@ class Simulation {
   Stepper& stepper() { return stepper_; }
 
   Diagnostics diagnostics();
+  // What adaptive steps estimate the next step from; global maxima, reads the ghosts of r.
+  StateMeasures state_measures();
   // The stored energy of MODEL.md §2.5 at the current positions (J); a global sum that costs
   // about one force evaluation, so not part of diagnostics().
   double elastic_energy() { return dynamics_.elastic_energy(stepper_.positions()); }

@@ -57,23 +57,45 @@ class Stepper {
   Stepper(const Stepper&) = delete;
   Stepper& operator=(const Stepper&) = delete;
 
-  // Advances one step. On instability the state is left at the last good step and the
-  // failure is returned.
+  // Advances one step of the scene's fixed size. On instability the state is left at the last
+  // good step and the failure is returned.
   std::optional<Instability> step();
+  // Advances one step of size dt that ends at `end_time`: time() + dt, or a frame's time the
+  // step was cut to reach exactly (adaptive steps). As step() otherwise.
+  std::optional<Instability> step(double dt, double end_time);
+
+  // The whole state in memory, for adaptive steps to roll back to.
+  struct Snapshot {
+    long step = 0;
+    double time = 0.0;
+    double last_dt = 0.0;
+    std::vector<Field<Vec3>> fields;
+    std::vector<double> scalars;
+    std::vector<Constraints::NodeState> constraints;
+  };
+  Snapshot snapshot();
+  void restore(const Snapshot& snapshot);
 
   // Runs `action` on every later step, after those added before it.
   void add_action(std::unique_ptr<StepAction> action) { actions_.push_back(std::move(action)); }
 
   using StateField = Scheme::StateField;
-  // The fields that carry the scheme's state from one step to the next: together with the
-  // step index and the constraints' state, all a restart needs to continue bitwise.
+  using StateScalar = Scheme::StateScalar;
+  // The fields and numbers that carry the scheme's state from one step to the next: together
+  // with the step index, the time and the constraints' state, all a restart needs to continue
+  // bitwise.
   std::vector<StateField> state_fields() { return scheme_->state_fields(); }
+  std::vector<StateScalar> state_scalars() { return scheme_->state_scalars(); }
   Constraints& constraints() { return constraints_; }
-  // Continues from `step` after the state fields and constraints were overwritten.
+  // Continues from `step` after the state was overwritten; with a fixed step the time is
+  // step x dt, adaptive steps give the time and the size of the step that ended there.
   void resume(long step);
+  void resume(long step, double time, double last_dt);
 
   long step_index() const { return step_; }
   double time() const { return time_; }
+  // The size of the last step taken (the scene's step before the first).
+  double last_dt() const { return dt_; }
   const Field<Vec3>& positions() const { return scheme_->positions(); }
   // The scheme's velocity at the current time; for the Verlet family, which carries none,
   // the backward difference (r − r⁻)/Δt, the velocity half a step back.
@@ -83,9 +105,10 @@ class Stepper {
   std::optional<LinearSolveStats> linear_solves() const { return scheme_->linear_solves(); }
 
  private:
-  std::optional<Instability> check(const Field<Vec3>& next) const;
+  std::optional<Instability> check(const Field<Vec3>& next, double end_time) const;
 
   const Block* block_;
+  Dynamics* dynamics_;
   Constraints constraints_;
   double dt_;
   double h1_, h2_;

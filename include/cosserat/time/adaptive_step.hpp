@@ -1,0 +1,54 @@
+#pragma once
+// Adaptive steps (docs/stability.md, "Adaptive steps"): the step follows the stability estimate
+// of the current state times a safety factor, is cut to land on the frame times, and shrinks
+// after the monitor of MODEL.md §4.2 trips and the run rolls back. Every choice is made from
+// global maxima, which are exact, so the steps are the same on any number of ranks.
+
+#include "cosserat/scene/scene.hpp"
+
+namespace cosserat {
+
+// What the estimate reads from the current state; both global maxima.
+struct StateMeasures {
+  double stretch2 = 1.0;   // the largest |r_,α|² / |R_,α|² over the grid's edges
+  double max_speed = 0.0;  // m/s
+};
+
+// The step the state allows, before the safety factor: the CFL step of the rest sheet
+// (model/wave_speed.hpp) with its membrane part shortened by the stiffening of stretched
+// edges, and no more than a quarter of the smaller spacing per step at the fastest node (half
+// of what the monitor allows).
+double stability_estimate(const Scene& scene, const StateMeasures& state);
+
+class AdaptiveSteps {
+ public:
+  // `scale`: what earlier roll-backs left of the estimate (a restart's, from its checkpoint).
+  explicit AdaptiveSteps(const Scene& scene, double scale = 1.0);
+
+  struct Next {
+    double dt;
+    double end_time;  // time + dt, or exactly the frame time the step was cut to reach
+    bool frame;       // the step ends at a frame time (the last one is the duration)
+  };
+  // The step from `time`, after a step of `last_dt`, for a state estimated at `estimate`.
+  Next next(double time, double last_dt, double estimate) const;
+
+  // A step of `failed_dt` tripped the monitor: from now on the run takes half of what it took
+  // of the estimate. False when half the failed step is below time.dt.min: the run is
+  // unstable. The factor never grows back: an estimate that was too large once is so by a
+  // factor the state carries on (a fold, a stiffer bending mode), and growing back would only
+  // repeat the roll-back.
+  bool shrink(double failed_dt);
+
+  double scale() const { return scale_; }
+
+ private:
+  // The first frame time after `time`: j x output_dt, or the duration.
+  double frame_after(double time) const;
+
+  AdaptiveStep settings_;
+  double duration_, output_dt_;
+  double scale_;
+};
+
+}  // namespace cosserat

@@ -1,0 +1,62 @@
+#include "cosserat/time/adaptive_step.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "cosserat/model/wave_speed.hpp"
+
+namespace cosserat {
+
+namespace {
+// A step may grow by this factor over the last: tc-verlet stays second order on a smoothly
+// varying step, and an estimate that jumps does not leap past the state it was read from.
+constexpr double kGrowth = 1.25;
+}  // namespace
+
+// A membrane strain ε = (λ² − 1)/2 along an edge stretched by λ stiffens the edge: the second
+// derivative of Φ ε² with respect to λ is Φ (3λ² − 1) (MODEL.md §2.5 with ε_αα as in §2.1), so
+// the membrane wave speed grows by √((3λ² − 1)/2) over the rest sheet's. Bending's rate is
+// that of the rest sheet (it does not stiffen with stretch to first order).
+double stability_estimate(const Scene& scene, const StateMeasures& state) {
+  const CflEstimate cfl =
+      cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
+  const double stiffening = std::max(1.0, 0.5 * (3.0 * state.stretch2 - 1.0));
+  double estimate = std::min(cfl.membrane_dt / std::sqrt(stiffening), cfl.bending_dt);
+  if (state.max_speed > 0.0)
+    estimate = std::min(estimate, 0.25 * std::min(scene.h1(), scene.h2()) / state.max_speed);
+  return estimate;
+}
+
+AdaptiveSteps::AdaptiveSteps(const Scene& scene, double scale)
+    : settings_(*scene.adaptive),
+      duration_(scene.duration),
+      output_dt_(scene.output_dt),
+      scale_(scale) {}
+
+double AdaptiveSteps::frame_after(double time) const {
+  // The smallest j with j x output_dt > time, found from the products themselves, which are
+  // the frame times, so that a time that landed on a frame is never taken for just before it.
+  double j = std::floor(time / output_dt_);
+  while (j * output_dt_ <= time) j += 1.0;
+  while (j > 1.0 && (j - 1.0) * output_dt_ > time) j -= 1.0;
+  return std::min(j * output_dt_, duration_);
+}
+
+AdaptiveSteps::Next AdaptiveSteps::next(double time, double last_dt, double estimate) const {
+  double dt = std::min({scale_ * settings_.safety * estimate, settings_.max, kGrowth * last_dt});
+  // The estimate is advice; only the monitor declares a run unstable (then below min).
+  dt = std::max(dt, settings_.min);
+  const double target = frame_after(time);
+  const double left = target - time;
+  // Cut to land on the frame; split the rest evenly rather than leave a sliver of a step.
+  if (left <= dt) return Next{left, target, true};
+  if (left < 2.0 * dt) dt = 0.5 * left;
+  return Next{dt, time + dt, false};
+}
+
+bool AdaptiveSteps::shrink(double failed_dt) {
+  scale_ *= 0.5;
+  return 0.5 * failed_dt >= settings_.min;
+}
+
+}  // namespace cosserat
