@@ -329,6 +329,29 @@ TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
   EXPECT_TRUE(killed[2] == whole[2]) << "/step differs";
 }
 
+// Issue 12, defect 13: the XDMF file grows by one element per frame, in place. A run killed
+// at any moment leaves an XDMF file that parses (Python's XML parser standing in for ParaView's)
+// and names frames the HDF5 file holds: all of them, or all but the one being written.
+TEST_F(Cli, XdmfOfAKilledRunParsesAndNamesItsFrames) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string run = std::string(COSSERAT_EXE) + " run " + scene +
+                          " --set grid.nodes=[30,30] --set time.steps=20000 "
+                          "--set time.output_every=40 -q -o " + path("killed.h5");
+  const Result killed =
+      shell("sh -c '" + run + " & pid=$!; until grep -qs frame_3 " + path("killed.xmf") +
+            "; do sleep 0.01; done; sleep 0.05; kill -9 $pid; wait $pid; echo killed $?'");
+  ASSERT_THAT(killed.output, HasSubstr("killed 137")) << killed.output;
+  std::ofstream(path("count.py")) << "import sys, xml.etree.ElementTree as tree\n"
+                                     "root = tree.parse(sys.argv[1]).getroot()\n"
+                                     "print(len(root.findall(\".//Grid[@GridType='Uniform']\")))\n";
+  const Result parsed = shell("/usr/bin/python3 " + path("count.py") + " " + path("killed.xmf"));
+  ASSERT_EQ(parsed.status, 0) << parsed.output;
+  const long named = std::stol(parsed.output);
+  const long frames = read_frames(path("killed.h5")).first;
+  EXPECT_GE(named, 2) << "killed before its second frame; kill later";
+  EXPECT_TRUE(named == frames || named == frames - 1) << named << " named, " << frames << " held";
+}
+
 TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=10 --checkpoint-every 10 -o " + path("a.h5")).status, 0);
