@@ -395,6 +395,32 @@ TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
   EXPECT_THAT(r.output, HasSubstr("out.xmf"));
 }
 
+// Issue 12, defect 4: a second run on the output of a run still writing it is refused, on one
+// rank and on two (both ranks end promptly; the timeout turns a hang into a failure), with exit
+// status 2 and a message naming the file, and the first run's file is left alone. The lock dies
+// with its process: after the first run is killed, a new run on the same output goes ahead.
+// Before, both runs wrote the file, exited 0 and left it unreadable.
+TEST_F(Cli, SecondRunOnAnOutputBeingWrittenIsRefused) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string first = std::string(COSSERAT_EXE) + " run " + scene +
+                            " --set grid.nodes=[30,30] --set time.steps=200000 "
+                            "--set time.output_every=500 -q -o " + path("out.h5");
+  const std::string second = "run " + scene + " -q -o " + path("out.h5");
+  const Result r = shell(
+      "sh -c '" + first + " & pid=$!; until grep -qs frame_1 " + path("out.xmf") +
+      "; do sleep 0.01; done; " + COSSERAT_EXE + " " + second + "; echo second $?; timeout 60 " +
+      on_ranks(2, second) + "; echo ranks $?; kill -0 $pid && echo first running; kill -9 $pid; " +
+      "wait $pid; " + COSSERAT_EXE + " " + second + "; echo third $?'");
+  EXPECT_THAT(r.output, HasSubstr("second 2\n"));
+  EXPECT_THAT(r.output, HasSubstr("ranks 2\n"));
+  EXPECT_THAT(r.output, HasSubstr("first running\n"));
+  EXPECT_THAT(r.output, HasSubstr("third 0\n")) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(path("out.h5") + " is locked by another process"));
+  const auto [frames, finite] = read_frames(path("out.h5"));
+  EXPECT_EQ(frames, 5) << "the third run's steps 0, 50, 100, 150, 200";
+  EXPECT_TRUE(finite);
+}
+
 // Issue 12: outputs that are devices or folders are bad input before any work; before, -o
 // /dev/null and -o /dev/full ran, failed to write, and crashed in MPI_Finalize (exit 139).
 TEST_F(Cli, OutputThatIsNotARegularFileIsBadInput) {
