@@ -127,13 +127,12 @@ void XdmfFile::append(double time) {
   const std::string element = frame_grid(h5_file_, m_, n_, frames_, time);
   if (!write_at(descriptor_, element + std::string(kTail), tail_offset_)) {
     const int error = errno;
+    const auto end = static_cast<off_t>(tail_offset_ + static_cast<long>(kTail.size()));
     const bool restored =
-        write_at(descriptor_, kTail, tail_offset_) &&
-        ftruncate(descriptor_, static_cast<off_t>(tail_offset_ + static_cast<long>(kTail.size()))) == 0;
-    throw std::runtime_error(fmt::format("XDMF file '{}': appending frame {} failed: {}{}", path_,
-                                         frames_, std::strerror(error),
-                                         restored ? " (the file still describes the earlier frames)"
-                                                  : ""));
+        write_at(descriptor_, kTail, tail_offset_) && ftruncate(descriptor_, end) == 0;
+    throw std::runtime_error(fmt::format(
+        "XDMF file '{}': appending frame {} failed: {}{}", path_, frames_, std::strerror(error),
+        restored ? " (the file still describes the earlier frames)" : ""));
   }
   tail_offset_ += static_cast<long>(element.size());
   ++frames_;
