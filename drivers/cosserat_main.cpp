@@ -22,6 +22,7 @@
 #include "cosserat/grid/reduce.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
+#include "cosserat/io/output_lock.hpp"
 #include "cosserat/io/stable_dt_table.hpp"
 #include "cosserat/io/summary.hpp"
 #include "cosserat/model/wave_speed.hpp"
@@ -272,12 +273,20 @@ int run(const RunOptions& options, int rank, int ranks) {
     }
   }
 
+  // One run writes an output at a time: the second is refused before it writes anything.
+  std::unique_ptr<OutputLock> lock;
+  try {
+    lock = std::make_unique<OutputLock>(output, MPI_COMM_WORLD);
+  } catch (const OutputBusy& e) {
+    if (rank == 0) fmt::print(stderr, "error: {}\n", e.what());
+    return kExitBadInput;
+  }
   std::unique_ptr<FrameWriter> writer;
   bool continued = false;
   try {
     // A restart continues the earlier run's file when there is one: the frames up to the
     // checkpoint are kept, and the frames written after it are written again.
-    continued = restarted_from && std::filesystem::exists(output);
+    continued = restarted_from && lock->had_contents();
     if (continued)
       writer = std::make_unique<FrameWriter>(
           output, simulation.block(), *restarted_from, scene.text,

@@ -195,7 +195,10 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
   resize_series(*file_, datasets_->step, kept, what);
   file_->write_attribute("status", std::string("running (restarted)"));
   file_->flush();
-  write_xdmf_file();
+  // Written whole once, for the frames kept: it may describe the dropped ones, or be the partial
+  // file of a run killed while appending.
+  if (rank_ == 0)
+    xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block.m, block.n, times_);
 }
 
 FrameWriter::~FrameWriter() = default;
@@ -217,13 +220,15 @@ void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positio
 
   times_.push_back(time);
   steps_.push_back(step);
-  write_xdmf_file();
+  if (rank_ != 0) return;
+  if (xdmf_)
+    xdmf_->append(time);
+  else
+    xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block_->m, block_->n, times_);
 }
 
-void FrameWriter::write_xdmf_file() const {
-  if (rank_ == 0)
-    write_xdmf(xmf_path_, std::filesystem::path(h5_path_).filename().string(), block_->m,
-               block_->n, times_);
+std::string FrameWriter::h5_filename() const {
+  return std::filesystem::path(h5_path_).filename().string();
 }
 
 void FrameWriter::set_attribute(const std::string& name, const std::string& value) {

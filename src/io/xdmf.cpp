@@ -1,8 +1,11 @@
 #include "cosserat/io/xdmf.hpp"
 
-#include <cstddef>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <stdexcept>
 #include <system_error>
 
@@ -25,65 +28,114 @@ std::string xml_escaped(const std::string& text) {
   return escaped;
 }
 
+constexpr std::string_view kHead = R"(<?xml version="1.0" ?>
+<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>
+<Xdmf Version="3.0">
+  <Domain>
+    <Grid Name="cloth" GridType="Collection" CollectionType="Temporal">
+)";
+
+constexpr std::string_view kTail = R"(    </Grid>
+  </Domain>
+</Xdmf>
+)";
+
 // One frame is a structured surface whose points are the slab [frame, 0:m, 0:n, 0:3] of
 // /positions. The slab is written in XDMF 3's own form, "file:/dataset|start:stride:count:extent"
 // inside a plain HDF item, because ParaView's XDMF 3 readers (its default for .xmf) do not read a
 // HyperSlab item as geometry: they look up the item's number type before reading it, and a
 // HyperSlab has none until read. ParaView's legacy XDMF 2 reader does not know this form.
-std::string frame_grid(const std::string& h5_file, int m, int n, std::size_t frame,
-                       std::size_t frames, double time) {
+// The extent is the dataset's when the frame was written, frame + 1 frames: XDMF 3 reads the
+// slab from the dataset as it is in the file (the extent only matters when XDMF writes), and a
+// frame's text that named the final count would have to be rewritten at every later frame.
+std::string frame_grid(const std::string& h5_file, int m, int n, std::size_t frame, double time) {
   return fmt::format(
       R"(      <Grid Name="frame_{frame}" GridType="Uniform">
         <Time Value="{time}"/>
         <Topology TopologyType="2DSMesh" Dimensions="{m} {n}"/>
         <Geometry GeometryType="XYZ">
           <DataItem Dimensions="{m} {n} 3" NumberType="Float" Precision="8"
-                    Format="HDF">{file}:/positions|{frame} 0 0 0:1 1 1 1:1 {m} {n} 3:{frames} {m} {n} 3</DataItem>
+                    Format="HDF">{file}:/positions|{frame} 0 0 0:1 1 1 1:1 {m} {n} 3:{extent} {m} {n} 3</DataItem>
         </Geometry>
       </Grid>
 )",
-      fmt::arg("frame", frame), fmt::arg("frames", frames), fmt::arg("time", time),
+      fmt::arg("frame", frame), fmt::arg("extent", frame + 1), fmt::arg("time", time),
       fmt::arg("m", m), fmt::arg("n", n), fmt::arg("file", h5_file));
 }
 
-std::string xdmf_document(const std::string& h5_filename_relative, int m, int n,
-                          const std::vector<double>& times) {
-  const std::string h5_file = xml_escaped(h5_filename_relative);
-  std::string document = R"(<?xml version="1.0" ?>
-<!DOCTYPE Xdmf SYSTEM "Xdmf.dtd" []>
-<Xdmf Version="3.0">
-  <Domain>
-    <Grid Name="cloth" GridType="Collection" CollectionType="Temporal">
-)";
-  for (std::size_t frame = 0; frame < times.size(); ++frame) {
-    document += frame_grid(h5_file, m, n, frame, times.size(), times[frame]);
+// Writes all of `text` at `offset`; false with errno set if the file took less.
+bool write_at(int descriptor, std::string_view text, long offset) {
+  std::size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t wrote = pwrite(descriptor, text.data() + written, text.size() - written,
+                                 static_cast<off_t>(offset) + static_cast<off_t>(written));
+    if (wrote < 0 && errno == EINTR) continue;
+    if (wrote <= 0) {
+      if (wrote == 0) errno = ENOSPC;
+      return false;
+    }
+    written += static_cast<std::size_t>(wrote);
   }
-  document += R"(    </Grid>
-  </Domain>
-</Xdmf>
-)";
-  return document;
+  return true;
 }
 
 }  // namespace
 
-void write_xdmf(const std::string& xmf_path, const std::string& h5_filename_relative, int m, int n,
-                const std::vector<double>& times) {
+std::string xdmf_document(const std::string& h5_filename_relative, int m, int n,
+                          const std::vector<double>& times) {
+  const std::string h5_file = xml_escaped(h5_filename_relative);
+  std::string document(kHead);
+  for (std::size_t frame = 0; frame < times.size(); ++frame)
+    document += frame_grid(h5_file, m, n, frame, times[frame]);
+  document += kTail;
+  return document;
+}
+
+XdmfFile::XdmfFile(const std::string& xmf_path, const std::string& h5_filename_relative, int m,
+                   int n, const std::vector<double>& times)
+    : path_(xmf_path), h5_file_(xml_escaped(h5_filename_relative)), m_(m), n_(n) {
   // The temporary sits in the same folder so that rename() replaces within one file system,
-  // which POSIX makes atomic.
+  // which POSIX makes atomic; the descriptor follows the file to its final name.
   const std::string partial_path = xmf_path + ".partial";
-  {
-    std::ofstream out(partial_path, std::ios::binary | std::ios::trunc);
-    out << xdmf_document(h5_filename_relative, m, n, times);
-    out.close();
-    if (!out) throw std::runtime_error(fmt::format("XDMF file '{}': write failed", partial_path));
+  descriptor_ = open(partial_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (descriptor_ < 0)
+    throw std::runtime_error(
+        fmt::format("XDMF file '{}': cannot create it: {}", partial_path, std::strerror(errno)));
+  const std::string document = xdmf_document(h5_filename_relative, m, n, times);
+  if (!write_at(descriptor_, document, 0)) {
+    const int error = errno;
+    close(descriptor_);
+    throw std::runtime_error(
+        fmt::format("XDMF file '{}': write failed: {}", partial_path, std::strerror(error)));
   }
   std::error_code error;
   std::filesystem::rename(partial_path, xmf_path, error);
   if (error) {
+    close(descriptor_);
     throw std::runtime_error(fmt::format("XDMF file '{}': rename from '{}' failed: {}", xmf_path,
                                          partial_path, error.message()));
   }
+  tail_offset_ = static_cast<long>(document.size() - kTail.size());
+  frames_ = times.size();
+}
+
+XdmfFile::~XdmfFile() { close(descriptor_); }
+
+// A write that extends the file can fail part way (a full disk); the closing tags then go back
+// where they were and the file is cut there, which needs no new space.
+void XdmfFile::append(double time) {
+  const std::string element = frame_grid(h5_file_, m_, n_, frames_, time);
+  if (!write_at(descriptor_, element + std::string(kTail), tail_offset_)) {
+    const int error = errno;
+    const auto end = static_cast<off_t>(tail_offset_ + static_cast<long>(kTail.size()));
+    const bool restored =
+        write_at(descriptor_, kTail, tail_offset_) && ftruncate(descriptor_, end) == 0;
+    throw std::runtime_error(fmt::format(
+        "XDMF file '{}': appending frame {} failed: {}{}", path_, frames_, std::strerror(error),
+        restored ? " (the file still describes the earlier frames)" : ""));
+  }
+  tail_offset_ += static_cast<long>(element.size());
+  ++frames_;
 }
 
 }  // namespace cosserat

@@ -329,6 +329,29 @@ TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
   EXPECT_TRUE(killed[2] == whole[2]) << "/step differs";
 }
 
+// Issue 12, defect 13: the XDMF file grows by one element per frame, in place. A run killed
+// at any moment leaves an XDMF file that parses (Python's XML parser standing in for ParaView's)
+// and names frames the HDF5 file holds: all of them, or all but the one being written.
+TEST_F(Cli, XdmfOfAKilledRunParsesAndNamesItsFrames) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string run = std::string(COSSERAT_EXE) + " run " + scene +
+                          " --set grid.nodes=[30,30] --set time.steps=20000 "
+                          "--set time.output_every=40 -q -o " + path("killed.h5");
+  const Result killed =
+      shell("sh -c '" + run + " & pid=$!; until grep -qs frame_3 " + path("killed.xmf") +
+            "; do sleep 0.01; done; sleep 0.05; kill -9 $pid; wait $pid; echo killed $?'");
+  ASSERT_THAT(killed.output, HasSubstr("killed 137")) << killed.output;
+  std::ofstream(path("count.py")) << "import sys, xml.etree.ElementTree as tree\n"
+                                     "root = tree.parse(sys.argv[1]).getroot()\n"
+                                     "print(len(root.findall(\".//Grid[@GridType='Uniform']\")))\n";
+  const Result parsed = shell("/usr/bin/python3 " + path("count.py") + " " + path("killed.xmf"));
+  ASSERT_EQ(parsed.status, 0) << parsed.output;
+  const long named = std::stol(parsed.output);
+  const long frames = read_frames(path("killed.h5")).first;
+  EXPECT_GE(named, 2) << "killed before its second frame; kill later";
+  EXPECT_TRUE(named == frames || named == frames - 1) << named << " named, " << frames << " held";
+}
+
 TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=10 --checkpoint-every 10 -o " + path("a.h5")).status, 0);
@@ -370,6 +393,32 @@ TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
   EXPECT_NE(r.status, 124) << "hung until the timeout: " << r.output;
   EXPECT_LT(seconds, 30.0);
   EXPECT_THAT(r.output, HasSubstr("out.xmf"));
+}
+
+// Issue 12, defect 4: a second run on the output of a run still writing it is refused, on one
+// rank and on two (both ranks end promptly; the timeout turns a hang into a failure), with exit
+// status 2 and a message naming the file, and the first run's file is left alone. The lock dies
+// with its process: after the first run is killed, a new run on the same output goes ahead.
+// Before, both runs wrote the file, exited 0 and left it unreadable.
+TEST_F(Cli, SecondRunOnAnOutputBeingWrittenIsRefused) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string first = std::string(COSSERAT_EXE) + " run " + scene +
+                            " --set grid.nodes=[30,30] --set time.steps=200000 "
+                            "--set time.output_every=500 -q -o " + path("out.h5");
+  const std::string second = "run " + scene + " -q -o " + path("out.h5");
+  const Result r = shell(
+      "sh -c '" + first + " & pid=$!; until grep -qs frame_1 " + path("out.xmf") +
+      "; do sleep 0.01; done; " + COSSERAT_EXE + " " + second + "; echo second $?; timeout 60 " +
+      on_ranks(2, second) + "; echo ranks $?; kill -0 $pid && echo first running; kill -9 $pid; " +
+      "wait $pid; " + COSSERAT_EXE + " " + second + "; echo third $?'");
+  EXPECT_THAT(r.output, HasSubstr("second 2\n"));
+  EXPECT_THAT(r.output, HasSubstr("ranks 2\n"));
+  EXPECT_THAT(r.output, HasSubstr("first running\n"));
+  EXPECT_THAT(r.output, HasSubstr("third 0\n")) << r.output;
+  EXPECT_THAT(r.output, HasSubstr(path("out.h5") + " is locked by another process"));
+  const auto [frames, finite] = read_frames(path("out.h5"));
+  EXPECT_EQ(frames, 5) << "the third run's steps 0, 50, 100, 150, 200";
+  EXPECT_TRUE(finite);
 }
 
 // Issue 12: outputs that are devices or folders are bad input before any work; before, -o

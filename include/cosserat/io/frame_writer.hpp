@@ -1,8 +1,9 @@
 #pragma once
 // The HDF5 output of a run (shared/spec/SCENE_FORMAT.md, "Output"): one frame of positions per
 // write_frame, written collectively by every rank as its block's hyperslab (parallel HDF5),
-// appended and flushed at once, with the XDMF file beside it rewritten each time by rank 0, so
-// that a killed run leaves both files readable with every frame written so far.
+// appended and flushed at once, and named in the XDMF file beside it by rank 0 (one element
+// appended per frame, xdmf.hpp), so that a killed run leaves both files readable with every
+// frame written so far.
 
 #include <memory>
 #include <string>
@@ -16,6 +17,7 @@ namespace cosserat {
 namespace hdf5 {
 class File;
 }
+class XdmfFile;
 
 // The XDMF file written beside the HDF5 file `h5_path`: the same name with .xmf.
 std::string xdmf_path(const std::string& h5_path);
@@ -55,11 +57,12 @@ class FrameWriter {
 
  private:
   struct Datasets;
-  void write_xdmf_file() const;
+  std::string h5_filename() const;
 
   const Block* block_;
   std::unique_ptr<hdf5::File> file_;
   std::unique_ptr<Datasets> datasets_;
+  std::unique_ptr<XdmfFile> xdmf_;  // rank 0's; created with the first frame
   std::string h5_path_;
   std::string xmf_path_;
   int rank_ = 0;

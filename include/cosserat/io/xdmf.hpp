@@ -2,16 +2,46 @@
 // The XDMF 3 description of /positions that lets ParaView open the HDF5 output as a time series
 // of structured surfaces (with its "Xdmf3 Reader S" or "T", the default for .xmf).
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
 namespace cosserat {
 
-// Writes xmf_path describing frames 0 .. times.size() - 1 of /positions, an array
-// [frames, m, n, 3] in h5_filename_relative (a path relative to the folder of xmf_path).
-// The file is written beside its final name and renamed into place, so a reader sees either
-// the previous version or the new one, never a partial file. Throws std::runtime_error.
-void write_xdmf(const std::string& xmf_path, const std::string& h5_filename_relative, int m, int n,
-                const std::vector<double>& times);
+// The whole XDMF text describing frames 0 .. times.size() - 1 of /positions, an array
+// [frames, m, n, 3] in h5_filename_relative (a path relative to the folder of the XDMF file).
+// Frame f's element does not depend on how many frames follow it, so that a growing series
+// adds one element per frame and rewrites nothing before it.
+std::string xdmf_document(const std::string& h5_filename_relative, int m, int n,
+                          const std::vector<double>& times);
+
+// The XDMF file of a run's output, growing by one frame at a time (docs/output.md). Every
+// failure throws std::runtime_error naming the file. Not collective: one rank owns it.
+class XdmfFile {
+ public:
+  // Writes xmf_path describing the frames at `times` (those already in the HDF5 file): beside
+  // its final name first, then renamed over it, so a reader sees the previous file or the new
+  // one, never a partial one. The file stays open for append().
+  XdmfFile(const std::string& xmf_path, const std::string& h5_filename_relative, int m, int n,
+           const std::vector<double>& times);
+  ~XdmfFile();
+  XdmfFile(const XdmfFile&) = delete;
+  XdmfFile& operator=(const XdmfFile&) = delete;
+
+  // Adds the next frame, at simulated `time`: one write of its element and the closing tags
+  // over the old closing tags, whatever the number of frames before it. If that write fails
+  // the closing tags are put back, so the file still describes the earlier frames.
+  void append(double time);
+
+  std::size_t frames() const { return frames_; }
+
+ private:
+  std::string path_;
+  std::string h5_file_;  // escaped for XML
+  int m_, n_;
+  int descriptor_ = -1;
+  long tail_offset_ = 0;  // where the closing tags start: the next frame's element goes there
+  std::size_t frames_ = 0;
+};
 
 }  // namespace cosserat
