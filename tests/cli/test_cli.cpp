@@ -4,6 +4,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <sched.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -23,6 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 struct Result {
   int status;
@@ -92,7 +94,7 @@ TEST_F(Cli, HelpDocumentsEveryOption) {
   const Result run = cosserat("run --help");
   EXPECT_EQ(run.status, 0);
   for (const char* option : {"--set", "--output", "--summary", "--quiet", "--checkpoint-every",
-                             "--restart", "--until-rest", "--petsc"})
+                             "--restart", "--until-rest", "--petsc", "--threads"})
     EXPECT_THAT(run.output, HasSubstr(option));
   const Result stable = cosserat("stable-dt --help");
   EXPECT_EQ(stable.status, 0);
@@ -370,6 +372,58 @@ TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
   EXPECT_NE(r.status, 124) << "hung until the timeout: " << r.output;
   EXPECT_LT(seconds, 30.0);
   EXPECT_THAT(r.output, HasSubstr("out.xmf"));
+}
+
+// The "threads" of a run's summary JSON, or -1.
+int summary_threads(const std::string& summary_path) {
+  std::stringstream json;
+  json << std::ifstream(summary_path).rdbuf();
+  const std::string text = json.str(), key = "\"threads\": ";
+  const auto at = text.find(key);
+  return at == std::string::npos ? -1 : std::stoi(text.substr(at + key.size()));
+}
+
+int cores_of_this_process() {
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  if (sched_getaffinity(0, sizeof(mask), &mask) != 0) return 1;
+  return CPU_COUNT(&mask);
+}
+
+// Issue 12, defect 15: two ranks given the same cores share them. Open MPI is told not to bind
+// (the environment variable, which another MPI ignores), so both ranks see every core of this
+// process; before, each started one thread per core, twice as many threads as cores.
+TEST_F(Cli, RanksSharingTheirCoresSplitThem) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string summary = path("s.json");
+  const Result r = shell("env -u OMP_NUM_THREADS OMPI_MCA_hwloc_base_binding_policy=none "
+                         "timeout 120 " +
+                         on_ranks(2, "run " + scene + " --set time.steps=10 -o " +
+                                         path("o.h5") + " --summary " + summary));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const int threads = summary_threads(summary);
+  EXPECT_GE(threads, 1) << r.output;
+  EXPECT_LE(threads, std::max(1, cores_of_this_process() / 2)) << r.output;
+  EXPECT_THAT(r.output, Not(HasSubstr("warning")));
+}
+
+// An explicit count wins over the default, --threads over OMP_NUM_THREADS, and more threads
+// than cores are run as asked, with a warning.
+TEST_F(Cli, ExplicitThreadCountWinsWithAWarningWhenCoresAreShort) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const int more = cores_of_this_process() + 1;
+  const std::string run = "run " + scene + " --set time.steps=10 -o " + path("o.h5") +
+                          " --summary " + path("s.json");
+  const Result from_environment =
+      shell("OMP_NUM_THREADS=" + std::to_string(more) + " " + COSSERAT_EXE + " " + run);
+  ASSERT_EQ(from_environment.status, 0) << from_environment.output;
+  EXPECT_EQ(summary_threads(path("s.json")), more);
+  EXPECT_THAT(from_environment.output, HasSubstr("warning: 1 rank on a node of"));
+  const Result from_option = shell("OMP_NUM_THREADS=1 " + std::string(COSSERAT_EXE) + " " + run +
+                                   " --threads " + std::to_string(more));
+  ASSERT_EQ(from_option.status, 0) << from_option.output;
+  EXPECT_EQ(summary_threads(path("s.json")), more);
+  EXPECT_EQ(cosserat(run + " --threads 0").status, 2);
 }
 
 // Issue 12: outputs that are devices or folders are bad input before any work; before, -o
