@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -424,6 +425,56 @@ TEST_F(Cli, ExplicitThreadCountWinsWithAWarningWhenCoresAreShort) {
   ASSERT_EQ(from_option.status, 0) << from_option.output;
   EXPECT_EQ(summary_threads(path("s.json")), more);
   EXPECT_EQ(cosserat(run + " --threads 0").status, 2);
+}
+
+// Writes `values` over the stretch [start, start + count) of a dataset of a closed HDF5 file.
+template <class T>
+void overwrite(const std::string& file, const std::string& dataset, std::vector<hsize_t> start,
+               std::vector<hsize_t> count, hid_t memory_type, const std::vector<T>& values) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t d = H5Dopen2(f, dataset.c_str(), H5P_DEFAULT);
+  const hid_t space = H5Dget_space(d);
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  const hid_t memory = H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr);
+  ASSERT_GE(H5Dwrite(d, memory_type, memory, space, H5P_DEFAULT, values.data()), 0);
+  H5Sclose(memory);
+  H5Sclose(space);
+  H5Dclose(d);
+  ASSERT_GE(H5Fclose(f), 0);
+}
+
+// Issue 12, defect 12: a checkpoint whose positions hold a NaN, or whose constraints name a node
+// outside the grid, is bad input on 2 ranks: exit 2 naming the file, promptly, before a step.
+// The NaN lies in rank 1's block. Before, the first restarted and stopped unstable (exit 3)
+// with the NaN as its "last good state", and the second ran as if the node were not there.
+TEST_F(Cli, CorruptCheckpointIsBadInputOnEveryRank) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string checkpoint = path("a.checkpoint.h5");
+  const auto restart = [&] {
+    return shell("timeout 60 " + on_ranks(2, "run " + scene + " --restart " + checkpoint +
+                                                  " -o " + path("b.h5")));
+  };
+  const auto checkpoint_at_step_10 = [&] {
+    const Result first = shell(on_ranks(2, "run " + scene + " -q --set time.steps=10 "
+                                           "--checkpoint-every 10 -o " + path("a.h5")));
+    ASSERT_EQ(first.status, 0) << first.output;
+  };
+  checkpoint_at_step_10();
+  overwrite<double>(checkpoint, "/positions", {5, 5, 0}, {1, 1, 3}, H5T_NATIVE_DOUBLE,
+                    {std::nan(""), 0.0, 0.0});
+  const Result nan_position = restart();
+  EXPECT_EQ(nan_position.status, 2) << nan_position.output;
+  EXPECT_THAT(nan_position.output, HasSubstr("checkpoint '" + checkpoint + "'"));
+  EXPECT_THAT(nan_position.output, HasSubstr("/positions at node [5, 5] is (nan, 0, 0), not finite"));
+  EXPECT_FALSE(fs::exists(path("b.h5")));
+
+  checkpoint_at_step_10();
+  overwrite<std::int32_t>(checkpoint, "/constraint_nodes", {1, 0}, {1, 2}, H5T_NATIVE_INT32,
+                          {0, 60});
+  const Result outside = restart();
+  EXPECT_EQ(outside.status, 2) << outside.output;
+  EXPECT_THAT(outside.output, HasSubstr("constraint node [0, 60] is outside the 6 x 6 grid"));
+  EXPECT_FALSE(fs::exists(path("b.h5")));
 }
 
 // Issue 12: outputs that are devices or folders are bad input before any work; before, -o
