@@ -2,7 +2,6 @@
 // step loop (time/step_loop.hpp) says when a frame or a checkpoint is due.
 
 #include <mpi.h>
-#include <omp.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -20,6 +19,7 @@
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/reduce.hpp"
+#include "cosserat/grid/threads.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
 #include "cosserat/io/output_lock.hpp"
@@ -53,6 +53,7 @@ struct RunOptions {
   std::string restart;
   long checkpoint_every = 0;
   std::optional<double> until_rest;
+  std::optional<int> threads;
   bool quiet = false;
 };
 
@@ -63,6 +64,7 @@ struct StableDtOptions {
   std::optional<double> duration;
   double tolerance = 0.02;
   std::string csv;
+  std::optional<int> threads;
   bool quiet = false;
 };
 
@@ -165,6 +167,22 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
   return all_fit != 0;
 }
 
+// Threads are set before the simulation is built, so that its fields are first touched by the
+// threads that will work on them. Returns this rank's count.
+int set_threads(const cosserat::Decomposition& decomposition, std::optional<int> requested,
+                int rank) {
+  const cosserat::ThreadPlacement placement = cosserat::place_threads(
+      MPI_COMM_WORLD, decomposition.block(rank, MPI_COMM_WORLD).owned_l(), requested);
+  if (rank == 0 && placement.oversubscribed())
+    fmt::print(stderr,
+               "warning: {} rank{} on a node of {} cores run {} threads in all: threads wait "
+               "for cores and every step waits for them (docs/parallel.md); give fewer threads "
+               "(--threads or OMP_NUM_THREADS) or fewer ranks\n",
+               placement.node_ranks, placement.node_ranks == 1 ? "" : "s", placement.node_cores,
+               placement.node_threads);
+  return placement.threads;
+}
+
 // Runs `work` and turns the bad input it reports into a message from rank 0: exit status 2, or
 // nothing when all went well. Every rank finds the same bad input, so all return together.
 template <class Work>
@@ -251,6 +269,7 @@ int run(const RunOptions& options, int rank, int ranks) {
     }
   MPI_Bcast(&conflicting, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (conflicting) return kExitBadInput;
+  const int threads = set_threads(*decomposition, options.threads, rank);
 
   // The semi-implicit baseline checks its solver names with PETSc while it is set up.
   std::unique_ptr<Simulation> simulation_owner;
@@ -305,7 +324,6 @@ int run(const RunOptions& options, int rank, int ranks) {
   }
   const std::string checkpoint = checkpoint_path(output);
 
-  const int threads = omp_get_max_threads();
   const bool on_terminal = !options.quiet && rank == 0 && isatty(STDERR_FILENO);
   if (!options.quiet && rank == 0) {
     const std::string steps =
@@ -406,6 +424,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
   std::vector<std::string> integrators = options.integrators;
   if (integrators.size() == 1 && integrators[0] == "all") integrators = integrator_names();
   std::vector<Scene> scenes;
+  std::optional<Decomposition> decomposition;
   double duration = 0.0;
   const auto status = bad_input(options.scene_path, rank, [&] {
     const Scene base = load_scene(options.scene_path, options.overrides);
@@ -423,9 +442,10 @@ int stable_dt(const StableDtOptions& options, int rank) {
       if (base.adaptive) overrides.push_back(fmt::format("time.dt={}", base.dt));
       scenes.push_back(load_scene(options.scene_path, overrides));
     }
-    Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
+    decomposition = Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
   });
   if (status) return *status;
+  set_threads(*decomposition, options.threads, rank);
 
   const Scene& first = scenes.front();
   const CflEstimate cfl = cfl_estimate(first.material, first.areal_density(), first.h1(), first.h2());
@@ -532,11 +552,18 @@ int main(int argc, char** argv) {
                           "PETSc options for the semi-implicit integrator, in one string "
                           "(e.g. \"-ksp_type cg -pc_type jacobi -ksp_rtol 1e-8\"); they override "
                           "the scene's [time.solver]. PETSC_OPTIONS is read too");
+  run_command->add_option("--threads", options.threads,
+                          "OpenMP threads per rank (default: OMP_NUM_THREADS if set, else the "
+                          "cores this rank may run on, shared with the ranks of its node given "
+                          "the same cores, and at most its block's rows)")
+      ->check(CLI::Range(1, 4096));
   run_command->add_flag("-q,--quiet", options.quiet,
                         "Print nothing but warnings and errors (the progress line is shown "
                         "only on a terminal anyway)");
   run_command->footer(
-      "Threads: OMP_NUM_THREADS (default: all cores). On a terminal a progress line shows the "
+      "Threads: --threads, else OMP_NUM_THREADS, else the cores of this rank's affinity mask "
+      "shared among the ranks of its node (a warning when a node's ranks x threads exceed its "
+      "cores). On a terminal a progress line shows the "
       "step, simulated time, steps/s and ETA. Ranks: mpirun -np P splits the grid into P "
       "blocks (see jobs/README.md).");
 
@@ -563,6 +590,9 @@ int main(int argc, char** argv) {
   stable_command->add_option("--csv", stable.csv, "Also write the table as CSV to this file");
   stable_command->add_option("--petsc", petsc_options,
                              "PETSc options for the semi-implicit integrator, as for run");
+  stable_command->add_option("--threads", stable.threads,
+                             "OpenMP threads per rank, as for run")
+      ->check(CLI::Range(1, 4096));
   stable_command->add_flag("-q,--quiet", stable.quiet, "No line per trial on stderr");
   stable_command->footer(
       "Each trial runs the scene for ceil(T/dt) steps without output. Steps start from the "

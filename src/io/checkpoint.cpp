@@ -1,11 +1,16 @@
 #include "cosserat/io/checkpoint.hpp"
 
+#include <cmath>
 #include <filesystem>
 #include <limits>
+#include <map>
+#include <set>
 #include <system_error>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "hdf5_file.hpp"
 
@@ -107,6 +112,155 @@ std::vector<Constraints::NodeState> read_constraints(const hdf5::File& file) {
   return states;
 }
 
+// The grid, integrator and time step the checkpoint was written for, its step and the peak
+// kinetic energy it carries: what is wrong with them, or nothing.
+std::optional<std::string> check_header(const hdf5::File& file, const std::string& path,
+                                        const Scene& scene, long& step,
+                                        std::optional<double>& peak) {
+  if (file.read_string_attribute("format") != kFormat)
+    return fmt::format("'{}' is not a cosserat checkpoint", path);
+  const long m = file.read_int_attribute("m"), n = file.read_int_attribute("n");
+  const std::string integrator = file.read_string_attribute("integrator");
+  const double dt = file.read_double_attribute("dt");
+  const bool adaptive = file.has_attribute("adaptive_scale");
+  if (adaptive != scene.adaptive.has_value())
+    return fmt::format("checkpoint '{}' was written with {} steps; this scene's steps are {}",
+                       path, adaptive ? "adaptive" : "fixed",
+                       scene.adaptive ? "adaptive" : "fixed");
+  if (m != scene.m || n != scene.n || integrator != integrator_name(scene.integrator) ||
+      dt != scene.dt)
+    return fmt::format(
+        "checkpoint '{}' was written for a {} x {} grid with {} at dt = {} s; this scene has "
+        "{} x {} with {} at dt = {} s",
+        path, m, n, integrator, dt, scene.m, scene.n, integrator_name(scene.integrator),
+        scene.dt);
+  step = file.read_int_attribute("step");
+  if (step < 0 || step > scene.steps)
+    return fmt::format("checkpoint '{}' is at step {}, outside this scene's steps 0 .. {}", path,
+                       step, scene.steps);
+  if (file.has_attribute("peak_kinetic_energy")) {
+    peak = file.read_double_attribute("peak_kinetic_energy");
+    if (!(std::isfinite(*peak) && *peak >= 0.0))
+      return fmt::format("checkpoint '{}': its peak kinetic energy is {}, not a finite number "
+                         ">= 0",
+                         path, *peak);
+  }
+  return std::nullopt;
+}
+
+// Adaptive steps: where the run stands in time, the step that ended there, tc-verlet's previous
+// step and what roll-backs left of the estimate.
+struct AdaptiveState {
+  double time = 0.0, last_dt = 0.0, scale = 1.0;
+  std::vector<double> scalars;
+};
+
+std::optional<std::string> read_adaptive_state(const hdf5::File& file, const std::string& path,
+                                               const Scene& scene, Stepper& stepper,
+                                               AdaptiveState& state) {
+  state.time = file.read_double_attribute("time");
+  state.last_dt = file.read_double_attribute("last_dt");
+  state.scale = file.read_double_attribute("adaptive_scale");
+  if (!(state.time >= 0.0 && state.time <= scene.duration))
+    return fmt::format("checkpoint '{}' is at t = {} s, outside this scene's duration of {} s",
+                       path, state.time, scene.duration);
+  if (!(state.last_dt > 0.0 && std::isfinite(state.last_dt) && state.scale > 0.0 &&
+        state.scale <= 1.0))
+    return fmt::format("checkpoint '{}': its last step {} s or its roll-back factor {} is not "
+                       "a step or a factor in (0, 1]",
+                       path, state.last_dt, state.scale);
+  for (const Stepper::StateScalar& x : stepper.state_scalars()) {
+    const double value = file.read_double_attribute(x.name);
+    if (!(value > 0.0 && std::isfinite(value)))
+      return fmt::format("checkpoint '{}': its {} is {}, not a step", path, x.name, value);
+    state.scalars.push_back(value);
+  }
+  return std::nullopt;
+}
+
+// A state field is a whole-grid [m][n][3] array; another shape would select outside the file's
+// array on some ranks only.
+std::optional<std::string> check_shape(const hdf5::File& file, const Handle& dataset,
+                                       const std::string& path, const std::string& name,
+                                       const Scene& scene) {
+  const std::string what = "read the shape of /" + name;
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  file.check(rank, what);
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  file.check(H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr), what);
+  const std::vector<hsize_t> expected{static_cast<hsize_t>(scene.m),
+                                      static_cast<hsize_t>(scene.n), 3};
+  if (dims == expected) return std::nullopt;
+  return fmt::format("checkpoint '{}': /{} is [{}], not the [{}, {}, 3] of this grid", path, name,
+                     fmt::join(dims, ", "), scene.m, scene.n);
+}
+
+// The constraints must be those of the scene's [[fix]] tables: every fixed node once, inside
+// the grid, holding only components some fix of it holds, at finite values. The list is the
+// same on every rank.
+std::optional<std::string> check_constraints(const std::vector<Constraints::NodeState>& states,
+                                             const std::string& path, const Scene& scene) {
+  std::map<std::pair<int, int>, std::uint8_t> axes_of;  // by (k, l): the components fixes hold
+  for (const Fix& fix : scene.fixes) {
+    std::uint8_t axes = 0;
+    for (int c = 0; c < 3; ++c)
+      if (fix.axes[static_cast<std::size_t>(c)]) axes |= static_cast<std::uint8_t>(1u << c);
+    for (const NodeIndex& node : fix.nodes.nodes) axes_of[{node.k, node.l}] |= axes;
+  }
+  std::set<std::pair<int, int>> seen;
+  for (const Constraints::NodeState& s : states) {
+    const std::string node = fmt::format("checkpoint '{}': constraint node [{}, {}]", path, s.k, s.l);
+    if (s.k < 0 || s.k >= scene.m || s.l < 0 || s.l >= scene.n)
+      return fmt::format("{} is outside the {} x {} grid", node, scene.m, scene.n);
+    const auto fixed = axes_of.find({s.k, s.l});
+    if (fixed == axes_of.end()) return node + " is held by no [[fix]] of this scene";
+    if (!seen.insert({s.k, s.l}).second) return node + " is listed twice";
+    if ((s.held & ~fixed->second) != 0)
+      return fmt::format("{} holds components {:#05b}, beyond the {:#05b} this scene's fixes "
+                         "hold",
+                         node, s.held, fixed->second);
+    if (!(std::isfinite(s.value.x) && std::isfinite(s.value.y) && std::isfinite(s.value.z)))
+      return fmt::format("{} is held at ({}, {}, {}), not finite", node, s.value.x, s.value.y,
+                         s.value.z);
+  }
+  for (const auto& [kl, axes] : axes_of)
+    if (!seen.contains(kl))
+      return fmt::format("checkpoint '{}' lacks node [{}, {}], which this scene fixes", path,
+                         kl.first, kl.second);
+  return std::nullopt;
+}
+
+// The first node of this rank's block, in (l, k) order, whose value is not finite.
+std::optional<std::string> check_finite(const Field<Vec3>& field, const std::string& path,
+                                        const std::string& name) {
+  const Block& b = field.block();
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      const Vec3 r = field(k, l);
+      if (!(std::isfinite(r.x) && std::isfinite(r.y) && std::isfinite(r.z)))
+        return fmt::format("checkpoint '{}': /{} at node [{}, {}] is ({}, {}, {}), not finite",
+                           path, name, k, l, r.x, r.y, r.z);
+    }
+  return std::nullopt;
+}
+
+// The problem of the lowest rank that found one, on every rank: a rank that refused alone
+// would leave the others waiting in the run's first collective call.
+std::optional<std::string> first_of_any_rank(const std::optional<std::string>& problem,
+                                             MPI_Comm comm) {
+  const int mine = problem ? rank_in(comm) : size_of(comm);
+  int first = 0;
+  MPI_Allreduce(&mine, &first, 1, MPI_INT, MPI_MIN, comm);
+  if (first == size_of(comm)) return std::nullopt;
+  std::string text = problem.value_or("");
+  int length = static_cast<int>(text.size());
+  MPI_Bcast(&length, 1, MPI_INT, first, comm);
+  text.resize(static_cast<std::size_t>(length));
+  MPI_Bcast(text.data(), length, MPI_CHAR, first, comm);
+  return text;
+}
+
 }  // namespace
 
 std::string checkpoint_path(const std::string& output_path) {
@@ -133,7 +287,7 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
     file.write_attribute("time", simulation.time());
     if (rest_peak) file.write_attribute("peak_kinetic_energy", *rest_peak);
     if (scene.adaptive) {
-      // Adaptive steps continue bitwise only from the same step history and roll-back bound.
+      // Adaptive steps continue bitwise only from the same step history and roll-back factor.
       file.write_attribute("last_dt", simulation.stepper().last_dt());
       file.write_attribute("adaptive_scale", adaptive_scale.value_or(1.0));
       for (const Stepper::StateScalar& x : simulation.stepper().state_scalars())
@@ -166,56 +320,45 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
 long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,
                      std::optional<double>* rest_peak, double* adaptive_scale) {
   const Block& b = simulation.block();
+  std::optional<std::string> problem;
+  long step = 0;
+  std::optional<double> peak;
+  std::vector<Constraints::NodeState> constraints;
+  AdaptiveState adaptive;
   try {
     const hdf5::File file(path, b.comm, hdf5::File::Mode::read);
-    if (file.read_string_attribute("format") != kFormat)
-      throw CheckpointError(fmt::format("'{}' is not a cosserat checkpoint", path));
-    const long m = file.read_int_attribute("m"), n = file.read_int_attribute("n");
-    const std::string integrator = file.read_string_attribute("integrator");
-    const double dt = file.read_double_attribute("dt");
-    const bool adaptive = file.has_attribute("adaptive_scale");
-    if (adaptive != scene.adaptive.has_value())
-      throw CheckpointError(fmt::format(
-          "checkpoint '{}' was written with {} steps; this scene's steps are {}", path,
-          adaptive ? "adaptive" : "fixed", scene.adaptive ? "adaptive" : "fixed"));
-    if (m != scene.m || n != scene.n || integrator != integrator_name(scene.integrator) ||
-        dt != scene.dt)
-      throw CheckpointError(fmt::format(
-          "checkpoint '{}' was written for a {} x {} grid with {} at dt = {} s; this scene has "
-          "{} x {} with {} at dt = {} s",
-          path, m, n, integrator, dt, scene.m, scene.n, integrator_name(scene.integrator),
-          scene.dt));
-    const long step = file.read_int_attribute("step");
-    if (rest_peak != nullptr && file.has_attribute("peak_kinetic_energy"))
-      *rest_peak = file.read_double_attribute("peak_kinetic_energy");
-    if (step < 0 || step > scene.steps)
-      throw CheckpointError(fmt::format("checkpoint '{}' is at step {}, past this scene's {} steps",
-                                        path, step, scene.steps));
+    // Every rank reads the same attributes and shapes, so each check below fails on all ranks
+    // alike, before the collective reads of the fields.
+    problem = check_header(file, path, scene, step, peak);
+    if (!problem && scene.adaptive)
+      problem = read_adaptive_state(file, path, scene, simulation.stepper(), adaptive);
     for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
+      if (problem) break;
       const Handle dataset = file.open(H5Dopen2(file.get(), ("/" + f.name).c_str(), H5P_DEFAULT),
                                        H5Dclose, "open /" + f.name);
-      file.read_block(dataset.get(), *f.field, "read /" + f.name);
+      problem = check_shape(file, dataset, path, f.name, scene);
+      if (!problem) file.read_block(dataset.get(), *f.field, "read /" + f.name);
     }
-    simulation.stepper().constraints().restore(read_constraints(file));
-    if (adaptive) {
-      const double time = file.read_double_attribute("time");
-      if (!(time >= 0.0 && time <= scene.duration))
-        throw CheckpointError(fmt::format("checkpoint '{}' is at t = {} s, outside this scene's "
-                                          "duration of {} s",
-                                          path, time, scene.duration));
-      for (const Stepper::StateScalar& x : simulation.stepper().state_scalars())
-        *x.value = file.read_double_attribute(x.name);
-      if (adaptive_scale != nullptr) *adaptive_scale = file.read_double_attribute("adaptive_scale");
-      simulation.stepper().resume(step, time, file.read_double_attribute("last_dt"));
-    } else {
-      simulation.stepper().resume(step);
-    }
-    return step;
-  } catch (const CheckpointError&) {
-    throw;
+    if (!problem) constraints = read_constraints(file);
   } catch (const std::runtime_error& e) {
-    throw CheckpointError(fmt::format("cannot restart from '{}': {}", path, e.what()));
+    problem = fmt::format("cannot restart from '{}': {}", path, e.what());
   }
+  if (!problem) problem = check_constraints(constraints, path, scene);
+  for (const Stepper::StateField& f : simulation.stepper().state_fields())
+    if (!problem) problem = check_finite(*f.field, path, f.name);
+  if (const auto refused = first_of_any_rank(problem, b.comm)) throw CheckpointError(*refused);
+
+  simulation.stepper().constraints().restore(constraints);
+  if (scene.adaptive) {
+    const std::vector<Stepper::StateScalar> scalars = simulation.stepper().state_scalars();
+    for (std::size_t i = 0; i < scalars.size(); ++i) *scalars[i].value = adaptive.scalars[i];
+    simulation.stepper().resume(step, adaptive.time, adaptive.last_dt);
+    if (adaptive_scale != nullptr) *adaptive_scale = adaptive.scale;
+  } else {
+    simulation.stepper().resume(step);
+  }
+  if (rest_peak != nullptr) *rest_peak = peak;
+  return step;
 }
 
 }  // namespace cosserat

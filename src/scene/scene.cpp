@@ -54,6 +54,49 @@ Vec3 unit_direction(const Entry& entry) {
   return scaled / norm(scaled);
 }
 
+// The spacing L / (nodes - 1), as Scene::h1 and h2 give it. The bending rate of the explicit step grows as
+// 1/h⁴ (docs/stability.md) and node masses scale as h²: h⁴ and 1/h⁴ must both be normal
+// doubles, or the first step's forces overflow or vanish (a run then stopped unstable at step 1).
+void check_spacing(const Entry& size, double length, int nodes) {
+  const double h = length / (nodes - 1);
+  const double h4 = (h * h) * (h * h);
+  constexpr double smallest = std::numeric_limits<double>::min();
+  if (!(h4 >= smallest && h4 <= 1.0 / smallest)) {
+    size.fail(fmt::format("gives a grid spacing of {:.6g} m over {} nodes, whose fourth power "
+                          "{} a double; the spacing must be between {:.3g} and {:.3g} m",
+                          h, nodes, h4 < smallest ? "underflows" : "overflows",
+                          std::pow(smallest, 0.25), std::pow(smallest, -0.25)));
+  }
+}
+
+// Rest positions are doubles, origin + k h1 u + l h2 v, and the rest metric is their
+// differences, each exact only to ε times the largest coordinate. That error must stay below
+// 1e-6 of a spacing: beyond, neighbours merge (origin + h == origin) or the rest sheet carries
+// strains of round-off larger than the ones a run resolves.
+void check_resolvable(const Scene& scene, const std::optional<Entry>& origin,
+                      const std::vector<Entry>& size) {
+  double reach = 0.0, extent = 0.0;
+  for (const int k : {0, scene.m - 1})
+    for (const int l : {0, scene.n - 1}) {
+      const Vec3 along = (k * scene.h1()) * scene.u + (l * scene.h2()) * scene.v;
+      const Vec3 r = scene.origin + along;
+      for (int c = 0; c < 3; ++c) {
+        reach = std::max(reach, std::abs(r[c]));
+        extent = std::max(extent, std::abs(along[c]));
+      }
+    }
+  const double spacing = std::min(scene.h1(), scene.h2());
+  const double error = reach * std::numeric_limits<double>::epsilon();
+  if (error <= 1e-6 * spacing) return;
+  const std::string what = fmt::format(
+      "puts nodes {:.3g} m from 0, where doubles resolve {:.3g} m, more than 1e-6 of the grid "
+      "spacing {:.3g} m",
+      reach, error, spacing);
+  if (origin && reach > 2.0 * extent) origin->fail(what + ": move the origin nearer to 0");
+  size[scene.h1() <= scene.h2() ? 0 : 1].fail(what +
+                                              ": the cells are too narrow for the sheet's extent");
+}
+
 void read_grid(const Table& grid, Scene& scene) {
   grid.allow({"nodes", "size", "origin", "u", "v"});
 
@@ -66,8 +109,11 @@ void read_grid(const Table& grid, Scene& scene) {
                         .elements(2, "an array of 2 numbers [L1, L2] in metres, each > 0");
   scene.size1 = positive(size[0]);
   scene.size2 = positive(size[1]);
+  check_spacing(size[0], scene.size1, scene.m);
+  check_spacing(size[1], scene.size2, scene.n);
 
-  if (const auto origin = grid.find("origin")) scene.origin = origin->vector3();
+  const auto origin = grid.find("origin");
+  if (origin) scene.origin = origin->vector3();
 
   const auto u = grid.find("u");
   const auto v = grid.find("v");
@@ -80,6 +126,7 @@ void read_grid(const Table& grid, Scene& scene) {
     blamed.fail(fmt::format("must not be parallel to grid.{} (u and v span the rest sheet)",
                             v ? "u" : "v"));
   }
+  check_resolvable(scene, origin, size);
 }
 
 Preset preset_named(const Entry& entry) {

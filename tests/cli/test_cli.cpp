@@ -4,12 +4,14 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <hdf5.h>
+#include <sched.h>
 #include <sys/wait.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -23,6 +25,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 struct Result {
   int status;
@@ -92,7 +95,7 @@ TEST_F(Cli, HelpDocumentsEveryOption) {
   const Result run = cosserat("run --help");
   EXPECT_EQ(run.status, 0);
   for (const char* option : {"--set", "--output", "--summary", "--quiet", "--checkpoint-every",
-                             "--restart", "--until-rest", "--petsc"})
+                             "--restart", "--until-rest", "--petsc", "--threads"})
     EXPECT_THAT(run.output, HasSubstr(option));
   const Result stable = cosserat("stable-dt --help");
   EXPECT_EQ(stable.status, 0);
@@ -419,6 +422,108 @@ TEST_F(Cli, SecondRunOnAnOutputBeingWrittenIsRefused) {
   const auto [frames, finite] = read_frames(path("out.h5"));
   EXPECT_EQ(frames, 5) << "the third run's steps 0, 50, 100, 150, 200";
   EXPECT_TRUE(finite);
+}
+
+// The "threads" of a run's summary JSON, or -1.
+int summary_threads(const std::string& summary_path) {
+  std::stringstream json;
+  json << std::ifstream(summary_path).rdbuf();
+  const std::string text = json.str(), key = "\"threads\": ";
+  const auto at = text.find(key);
+  return at == std::string::npos ? -1 : std::stoi(text.substr(at + key.size()));
+}
+
+int cores_of_this_process() {
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  if (sched_getaffinity(0, sizeof(mask), &mask) != 0) return 1;
+  return CPU_COUNT(&mask);
+}
+
+// Issue 12, defect 15: two ranks given the same cores share them. Open MPI is told not to bind
+// (the environment variable, which another MPI ignores), so both ranks see every core of this
+// process; before, each started one thread per core, twice as many threads as cores.
+TEST_F(Cli, RanksSharingTheirCoresSplitThem) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string summary = path("s.json");
+  const Result r = shell("env -u OMP_NUM_THREADS OMPI_MCA_hwloc_base_binding_policy=none "
+                         "timeout 120 " +
+                         on_ranks(2, "run " + scene + " --set time.steps=10 -o " +
+                                         path("o.h5") + " --summary " + summary));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const int threads = summary_threads(summary);
+  EXPECT_GE(threads, 1) << r.output;
+  EXPECT_LE(threads, std::max(1, cores_of_this_process() / 2)) << r.output;
+  EXPECT_THAT(r.output, Not(HasSubstr("warning")));
+}
+
+// An explicit count wins over the default, --threads over OMP_NUM_THREADS, and more threads
+// than cores are run as asked, with a warning.
+TEST_F(Cli, ExplicitThreadCountWinsWithAWarningWhenCoresAreShort) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const int more = cores_of_this_process() + 1;
+  const std::string run = "run " + scene + " --set time.steps=10 -o " + path("o.h5") +
+                          " --summary " + path("s.json");
+  const Result from_environment =
+      shell("OMP_NUM_THREADS=" + std::to_string(more) + " " + COSSERAT_EXE + " " + run);
+  ASSERT_EQ(from_environment.status, 0) << from_environment.output;
+  EXPECT_EQ(summary_threads(path("s.json")), more);
+  EXPECT_THAT(from_environment.output, HasSubstr("warning: 1 rank on a node of"));
+  const Result from_option = shell("OMP_NUM_THREADS=1 " + std::string(COSSERAT_EXE) + " " + run +
+                                   " --threads " + std::to_string(more));
+  ASSERT_EQ(from_option.status, 0) << from_option.output;
+  EXPECT_EQ(summary_threads(path("s.json")), more);
+  EXPECT_EQ(cosserat(run + " --threads 0").status, 2);
+}
+
+// Writes `values` over the stretch [start, start + count) of a dataset of a closed HDF5 file.
+template <class T>
+void overwrite(const std::string& file, const std::string& dataset, std::vector<hsize_t> start,
+               std::vector<hsize_t> count, hid_t memory_type, const std::vector<T>& values) {
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+  const hid_t d = H5Dopen2(f, dataset.c_str(), H5P_DEFAULT);
+  const hid_t space = H5Dget_space(d);
+  H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+  const hid_t memory = H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr);
+  ASSERT_GE(H5Dwrite(d, memory_type, memory, space, H5P_DEFAULT, values.data()), 0);
+  H5Sclose(memory);
+  H5Sclose(space);
+  H5Dclose(d);
+  ASSERT_GE(H5Fclose(f), 0);
+}
+
+// Issue 12, defect 12: a checkpoint whose positions hold a NaN, or whose constraints name a node
+// outside the grid, is bad input on 2 ranks: exit 2 naming the file, promptly, before a step.
+// The NaN lies in rank 1's block. Before, the first restarted and stopped unstable (exit 3)
+// with the NaN as its "last good state", and the second ran as if the node were not there.
+TEST_F(Cli, CorruptCheckpointIsBadInputOnEveryRank) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string checkpoint = path("a.checkpoint.h5");
+  const auto restart = [&] {
+    return shell("timeout 60 " + on_ranks(2, "run " + scene + " --restart " + checkpoint +
+                                                  " -o " + path("b.h5")));
+  };
+  const auto checkpoint_at_step_10 = [&] {
+    const Result first = shell(on_ranks(2, "run " + scene + " -q --set time.steps=10 "
+                                           "--checkpoint-every 10 -o " + path("a.h5")));
+    ASSERT_EQ(first.status, 0) << first.output;
+  };
+  checkpoint_at_step_10();
+  overwrite<double>(checkpoint, "/positions", {5, 5, 0}, {1, 1, 3}, H5T_NATIVE_DOUBLE,
+                    {std::nan(""), 0.0, 0.0});
+  const Result nan_position = restart();
+  EXPECT_EQ(nan_position.status, 2) << nan_position.output;
+  EXPECT_THAT(nan_position.output, HasSubstr("checkpoint '" + checkpoint + "'"));
+  EXPECT_THAT(nan_position.output, HasSubstr("/positions at node [5, 5] is (nan, 0, 0), not finite"));
+  EXPECT_FALSE(fs::exists(path("b.h5")));
+
+  checkpoint_at_step_10();
+  overwrite<std::int32_t>(checkpoint, "/constraint_nodes", {1, 0}, {1, 2}, H5T_NATIVE_INT32,
+                          {0, 60});
+  const Result outside = restart();
+  EXPECT_EQ(outside.status, 2) << outside.output;
+  EXPECT_THAT(outside.output, HasSubstr("constraint node [0, 60] is outside the 6 x 6 grid"));
+  EXPECT_FALSE(fs::exists(path("b.h5")));
 }
 
 // Issue 12: outputs that are devices or folders are bad input before any work; before, -o

@@ -6,7 +6,11 @@
 #include <hdf5.h>
 #include <unistd.h>
 
+#include <array>
+#include <cstdint>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -138,6 +142,98 @@ TEST_F(Restart, RefusesACheckpointOfAnotherGridOrStep) {
   Simulation rk4(other_scheme, MPI_COMM_WORLD, any_scheme);
   EXPECT_THROW(read_checkpoint(checkpoint, rk4, other_scheme), CheckpointError);
   EXPECT_THROW(read_checkpoint((folder_ / "missing.h5").string(), sim, other_dt), CheckpointError);
+}
+
+// Rank 0 rewrites part of a dataset of a closed file, as damage or a hand edit would leave it;
+// the other ranks wait for it.
+template <class T>
+void overwrite(const std::string& file, const std::string& dataset, std::vector<hsize_t> start,
+               std::vector<hsize_t> count, hid_t memory_type, const std::vector<T>& values) {
+  if (world_rank() == 0) {
+    const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    const hid_t d = H5Dopen2(f, dataset.c_str(), H5P_DEFAULT);
+    const hid_t space = H5Dget_space(d);
+    H5Sselect_hyperslab(space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr);
+    const hid_t memory = H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr);
+    EXPECT_GE(H5Dwrite(d, memory_type, memory, space, H5P_DEFAULT, values.data()), 0);
+    H5Sclose(memory);
+    H5Sclose(space);
+    H5Dclose(d);
+    EXPECT_GE(H5Fclose(f), 0);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+}
+
+// Issue 12, defect 12: what a checkpoint holds is checked before a restart uses it, and every
+// rank refuses alike, even where the bad value lies in one rank's block. Before, a NaN started
+// the run and constraints outside the grid or of no fix were ignored.
+TEST_F(Restart, RefusesACheckpointWhoseContentsTheSceneCannotContinue) {
+  const Scene scene = testing::odd_grid_scene(Integrator::verlet);
+  const auto write = [&](std::optional<double> peak = {}) {
+    Simulation sim(scene, MPI_COMM_WORLD, any_scheme);
+    ASSERT_TRUE(testing::advance(sim, 5));
+    write_checkpoint(checkpoint(), sim, scene, "test", peak);
+  };
+  // The message every rank got, or "" when the checkpoint was taken.
+  const auto refusal = [&] {
+    Simulation sim(scene, MPI_COMM_WORLD, any_scheme);
+    try {
+      read_checkpoint(checkpoint(), sim, scene);
+    } catch (const CheckpointError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const auto expect_refused = [&](const std::string& what) {
+    const std::string message = refusal();
+    EXPECT_NE(message.find(checkpoint()), std::string::npos) << message;
+    EXPECT_NE(message.find(what), std::string::npos) << message;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const hsize_t m = static_cast<hsize_t>(scene.m), n = static_cast<hsize_t>(scene.n);
+
+  write();
+  ASSERT_EQ(refusal(), "");
+  // The last node: in the last rank's block for every split.
+  overwrite<double>(checkpoint(), "/previous_positions", {m - 1, n - 1, 0}, {1, 1, 3},
+                    H5T_NATIVE_DOUBLE, {0.0, nan, 0.0});
+  expect_refused("/previous_positions at node [36, 22] is (0, nan, 0), not finite");
+
+  write();
+  overwrite<std::int32_t>(checkpoint(), "/constraint_nodes", {0, 0}, {1, 2}, H5T_NATIVE_INT32,
+                          {37, 5});
+  expect_refused("constraint node [37, 5] is outside the 37 x 23 grid");
+  write();
+  overwrite<std::int32_t>(checkpoint(), "/constraint_nodes", {0, 0}, {1, 2}, H5T_NATIVE_INT32,
+                          {18, 20});
+  expect_refused("constraint node [18, 20] is held by no [[fix]] of this scene");
+  write();
+  overwrite<std::uint8_t>(checkpoint(), "/constraint_held", {0, 0}, {1, 1}, H5T_NATIVE_UINT8,
+                          {8});
+  expect_refused("beyond the");
+  write();
+  overwrite<double>(checkpoint(), "/constraint_values", {0, 0}, {1, 3}, H5T_NATIVE_DOUBLE,
+                    {0.0, 0.0, std::numeric_limits<double>::infinity()});
+  expect_refused("not finite");
+
+  write(nan);
+  expect_refused("peak kinetic energy is nan");
+
+  // /positions of another shape than the grid's.
+  write();
+  if (world_rank() == 0) {
+    const hid_t f = H5Fopen(checkpoint().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    EXPECT_GE(H5Ldelete(f, "/positions", H5P_DEFAULT), 0);
+    const std::array<hsize_t, 3> dims{m, n + 1, 3};
+    const hid_t space = H5Screate_simple(3, dims.data(), nullptr);
+    const hid_t d = H5Dcreate2(f, "/positions", H5T_IEEE_F64LE, space, H5P_DEFAULT,
+                               H5P_DEFAULT, H5P_DEFAULT);
+    H5Dclose(d);
+    H5Sclose(space);
+    H5Fclose(f);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  expect_refused("/positions is [37, 24, 3], not the [37, 23, 3] of this grid");
 }
 
 using Output = SharedFolder;

@@ -444,6 +444,50 @@ TEST(SceneError, SizeNotPositive) {
               AllOf(HasSubstr("key 'grid.size[1]'"), HasSubstr("must be > 0, got 0")));
 }
 
+// Issue 12, defect 8: grids whose spacing or positions a double cannot carry are bad input
+// naming the key; before, each ran and stopped unstable (exit 3) at step 1.
+TEST(SceneError, SpacingWhoseFourthPowerIsNotANormalDouble) {
+  SceneText text;
+  for (const char* size : {"[1e-300, 1.0]", "[1e-100, 1.0]", "[1e300, 1.0]", "[1e100, 1.0]"}) {
+    text.grid = std::string("nodes = [8, 8]\nsize = ") + size + "\n";
+    EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'grid.size[0]'"),
+                                      HasSubstr("grid spacing"), HasSubstr("fourth power")))
+        << size;
+  }
+  text.grid = "nodes = [8, 8]\nsize = [1.0, 1e-80]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'grid.size[1]'"), HasSubstr("underflows")));
+}
+
+TEST(SceneError, OriginTooFarForTheSpacing) {
+  SceneText text;
+  for (const char* origin : {"[1e300, 0, 0]", "[0, 1e17, 0]", "[0, 0, -1e12]"}) {
+    text.grid = std::string("nodes = [8, 8]\nsize = [1.0, 1.0]\norigin = ") + origin + "\n";
+    EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'grid.origin'"),
+                                      HasSubstr("move the origin nearer to 0")))
+        << origin;
+  }
+}
+
+TEST(SceneError, CellsTooNarrowForTheExtent) {
+  SceneText text;
+  text.grid = "nodes = [10, 10]\nsize = [1e6, 1e-6]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'grid.size[1]'"), HasSubstr("too narrow")));
+  text.grid = "nodes = [8, 8]\nsize = [1e-60, 1e60]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'grid.size[0]'"), HasSubstr("too narrow")));
+}
+
+// The bounds are those of doubles, not of cloth: far-off and tiny grids are accepted as long as
+// a double resolves them.
+TEST(Scene, ExtremeButResolvableGridsAreAccepted) {
+  SceneText text;
+  text.grid = "nodes = [8, 8]\nsize = [1e-70, 1e-70]\n";
+  EXPECT_NO_THROW(parse(text));
+  text.grid = "nodes = [8, 8]\nsize = [1e70, 1e70]\norigin = [1e72, 0, 0]\n";
+  EXPECT_NO_THROW(parse(text));
+  text.grid = "nodes = [8, 8]\nsize = [1.0, 1.0]\norigin = [1e6, -1e6, 1e6]\n";
+  EXPECT_NO_THROW(parse(text));
+}
+
 TEST(SceneError, ZeroLengthDirection) {
   SceneText text;
   text.grid += "u = [0, 0, 0]\n";

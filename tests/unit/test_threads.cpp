@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include "cosserat/grid/threads.hpp"
 #include "support/sheets.hpp"
 
 namespace cosserat {
@@ -42,6 +43,19 @@ TEST(Threads, TrajectoryIsBitwiseTheSameForOneAndThreeThreads) {
     }
   }
   omp_set_num_threads(1);
+}
+
+// Issue 12, defect 15: a rank's default is its share of the cores it was given, and no more
+// than its block's rows; never 0.
+TEST(Threads, DefaultIsTheRanksShareOfItsCoresAndAtMostItsRows) {
+  EXPECT_EQ(default_threads(16, 1, 1000), 16);
+  EXPECT_EQ(default_threads(16, 4, 1000), 4);   // four ranks sharing one mask of 16 cores
+  EXPECT_EQ(default_threads(16, 3, 1000), 5);   // the remainder stays idle, not oversubscribed
+  EXPECT_EQ(default_threads(2, 4, 1000), 1);    // more ranks than cores: one thread each
+  EXPECT_EQ(default_threads(1, 1, 1000), 1);    // a rank bound to its own core
+  EXPECT_EQ(default_threads(64, 1, 10), 10);    // a 10-row block keeps 10 threads busy
+  EXPECT_EQ(default_threads(64, 2, 0), 1);      // a block with no rows still runs its thread
+  EXPECT_EQ(default_threads(0, 0, 100), 1);     // no mask read: one thread, not zero
 }
 
 }  // namespace

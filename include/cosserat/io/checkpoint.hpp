@@ -31,8 +31,12 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
                       std::optional<double> adaptive_scale = {});
 
 // Loads a checkpoint into `simulation`, built for `scene` on any decomposition, and returns its
-// step. Throws CheckpointError if the file cannot be read as a checkpoint or was written for a
-// different grid, integrator or time step. Collective.
+// step. Throws CheckpointError, on every rank alike and naming the file, if the file cannot be
+// read as a checkpoint, was written for a different grid, integrator or time step, or holds
+// what this scene cannot continue from: a step outside its steps, fields of another shape or
+// with a value that is not finite, constraints other than its fixes' (nodes outside the grid
+// or fixed by no [[fix]], components no fix holds, values not finite, fixed nodes missing), a
+// peak kinetic energy that is not finite or negative. Collective.
 // With `rest_peak`, also the peak kinetic energy the checkpoint carries (empty if none); with
 // `adaptive_scale`, what roll-backs left of adaptive steps' estimate.
 long read_checkpoint(const std::string& path, Simulation& simulation, const Scene& scene,

@@ -1,0 +1,84 @@
+#include "cosserat/grid/threads.hpp"
+
+#include <omp.h>
+#include <sched.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <vector>
+
+#include "cosserat/grid/block.hpp"
+
+namespace cosserat {
+
+int default_threads(int cores, int sharing, long rows) {
+  const long share = std::max(cores, 1) / std::max(sharing, 1);
+  return static_cast<int>(std::max(1L, std::min(share, rows)));
+}
+
+namespace {
+
+cpu_set_t affinity_mask() {
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  if (sched_getaffinity(0, sizeof(mask), &mask) != 0 || CPU_COUNT(&mask) == 0) {
+    // No mask to read: every online CPU, as the OpenMP runtime assumes then.
+    const long online = std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, long{CPU_SETSIZE});
+    for (long cpu = 0; cpu < online; ++cpu) CPU_SET(static_cast<int>(cpu), &mask);
+  }
+  return mask;
+}
+
+bool explicit_thread_count() {
+  const char* value = std::getenv("OMP_NUM_THREADS");
+  return value != nullptr && *value != '\0';
+}
+
+}  // namespace
+
+ThreadPlacement place_threads(MPI_Comm comm, long rows, std::optional<int> requested) {
+  MPI_Comm node;
+  MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, rank_in(comm), MPI_INFO_NULL, &node);
+  const int node_ranks = size_of(node);
+  const cpu_set_t mine = affinity_mask();
+  std::vector<cpu_set_t> masks(static_cast<std::size_t>(node_ranks));
+  MPI_Allgather(&mine, sizeof(cpu_set_t), MPI_BYTE, masks.data(), sizeof(cpu_set_t), MPI_BYTE,
+                node);
+  cpu_set_t all;
+  CPU_ZERO(&all);
+  int sharing = 0;
+  for (cpu_set_t& other : masks) {
+    cpu_set_t common;
+    CPU_AND(&common, &other, &mine);
+    if (CPU_COUNT(&common) > 0) ++sharing;
+    CPU_OR(&all, &all, &other);
+  }
+
+  ThreadPlacement placement;
+  placement.requested = requested.has_value() || explicit_thread_count();
+  if (requested)
+    omp_set_num_threads(*requested);
+  else if (!placement.requested)
+    omp_set_num_threads(default_threads(CPU_COUNT(&mine), sharing, rows));
+  placement.threads = omp_get_max_threads();
+
+  int node_threads = 0;
+  MPI_Allreduce(&placement.threads, &node_threads, 1, MPI_INT, MPI_SUM, node);
+  MPI_Comm_free(&node);
+  // Rank 0 reports one node: the one with the most threads per core.
+  const int node_cores = CPU_COUNT(&all);
+  struct {
+    double load;
+    int rank;
+  } local{static_cast<double>(node_threads) / node_cores, rank_in(comm)}, busiest{};
+  MPI_Allreduce(&local, &busiest, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm);
+  int figures[3] = {node_ranks, node_threads, node_cores};
+  MPI_Bcast(figures, 3, MPI_INT, busiest.rank, comm);
+  placement.node_ranks = figures[0];
+  placement.node_threads = figures[1];
+  placement.node_cores = figures[2];
+  return placement;
+}
+
+}  // namespace cosserat
