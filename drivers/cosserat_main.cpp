@@ -141,7 +141,7 @@ std::string describe(const cosserat::Instability& failure) {
   if (failure.solver_failure) return *failure.solver_failure;
   return fmt::format("node [{}, {}] {}; {}", failure.k, failure.l,
                      failure.not_finite ? "has a non-finite position"
-                                        : "moved more than half a grid spacing in one step",
+                                        : "moved more than half a grid spacing from a neighbour in one step",
                      failure.diagnosis);
 }
 

@@ -26,11 +26,13 @@ void Scheme::begin(Field<Vec3> velocities) {
   start(std::move(velocities));
 }
 
+void Scheme::exchange_next_positions(bool changed) {
+  if (changed || !exchanged_next_positions()) context_.halo.exchange(next_positions_);
+}
+
 void Scheme::accept() {
   accept_state();
   positions_.swap(next_positions_);
-  // The accepted positions are where the next step's forces are read.
-  if (!exchanged_next_positions()) context_.halo.exchange(positions_);
 }
 
 void Scheme::resume() {

@@ -32,7 +32,7 @@ StabilityTrial run_trial(const Scene& scene, double dt, double duration, MPI_Com
           failure->solver_failure
               ? fmt::format("step {}: {}", failure->step, *failure->solver_failure)
               : fmt::format("step {}: node [{}, {}] {}; {}", failure->step, failure->k,
-                            failure->l, failure->not_finite ? "not finite" : "moved > h/2",
+                            failure->l, failure->not_finite ? "not finite" : "moved > h/2 from a neighbour",
                             failure->diagnosis);
       break;
     }

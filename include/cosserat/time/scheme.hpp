@@ -65,7 +65,11 @@ class Scheme {
   // constraints. Returns why a linear solve failed, or nothing.
   virtual std::optional<std::string> advance(long step) = 0;
 
-  // The proposed state becomes the current one, its positions' ghosts exchanged.
+  // Exchanges the proposed positions' ghosts, unless advance() did and nothing changed them
+  // since (`changed`: a step action did). The stability check reads them.
+  void exchange_next_positions(bool changed);
+
+  // The proposed state, its positions' ghosts exchanged, becomes the current one.
   void accept();
 
   // After a restart overwrote the state fields.
