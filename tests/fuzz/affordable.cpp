@@ -2,6 +2,8 @@
 
 #include <toml++/toml.h>
 
+#include <cstdint>
+
 #include "checked_toml.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "overrides.hpp"
@@ -23,8 +25,9 @@ bool affordable(const std::string& text, const std::vector<std::string>& overrid
     return true;
   }
   if (!document.contains("fix") && !document.contains("load")) return true;
-  const auto m = document["grid"]["nodes"][0].value<long>();
-  const auto n = document["grid"]["nodes"][1].value<long>();
+  // value_exact: value<long> would convert a float such as 4.9e19 to long, which is undefined.
+  const auto m = document["grid"]["nodes"][0].value_exact<std::int64_t>();
+  const auto n = document["grid"]["nodes"][1].value_exact<std::int64_t>();
   if (!m || !n || *m < 1 || *n < 1) return true;
   return *m <= kMostNodesWithSets / *n;
 }
