@@ -44,7 +44,7 @@ build_debug() {
 }
 
 # AddressSanitizer + UndefinedBehaviorSanitizer (-O1 -g, gcc), only what the unit and cli tests
-# need; the test preset sets the sanitizers' options and the leak suppressions for Open MPI.
+# need; the presets set the sanitizers' options (leak detection off: Open MPI, README).
 build_asan() {
   cmake --preset asan >/dev/null
   cmake --build --preset asan -j "$(nproc)" --target unit_tests cli_tests
