@@ -3,7 +3,8 @@
 #   bash quickstart.sh demo   install what is missing, build, run S1, render s1_clothesline.png
 #   bash quickstart.sh test   install what is missing, build, run every test; then the debug
 #                             build (assertions, bounds and halo checks, FPE traps) runs the
-#                             unit and mpi tests again
+#                             unit and mpi tests again, the ASan + UBSan build the unit and
+#                             cli tests, and libFuzzer the scene loader for a minute
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -13,6 +14,7 @@ PACKAGES=(
   libtomlplusplus-dev libcli11-dev libfmt-dev libeigen3-dev
   libgtest-dev libgmock-dev libbenchmark-dev libpetsc-real-dev
   python3 python3-numpy python3-h5py python3-matplotlib
+  clang-14 libclang-rt-14-dev
 )
 BUILD_DIR=build/release
 
@@ -41,6 +43,21 @@ build_debug() {
   cmake --build --preset debug -j "$(nproc)" --target unit_tests mpi_tests
 }
 
+# AddressSanitizer + UndefinedBehaviorSanitizer (-O1 -g, gcc), only what the unit and cli tests
+# need; the presets set the sanitizers' options (leak detection off: Open MPI, README).
+build_asan() {
+  cmake --preset asan >/dev/null
+  cmake --build --preset asan -j "$(nproc)" --target unit_tests cli_tests
+}
+
+# The scene loader's libFuzzer targets (clang 14), each for COSSERAT_FUZZ_SECONDS (60) under
+# ctest; the fuzz preset builds nothing else.
+fuzz_scene_loader() {
+  cmake --preset fuzz >/dev/null
+  cmake --build --preset fuzz -j "$(nproc)" --target fuzz_scene_text fuzz_scene_set
+  ctest --preset fuzz -j "$(nproc)"
+}
+
 # Open MPI refuses to start as root unless told; everything here runs as root.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 
@@ -59,6 +76,9 @@ case "${1:-}" in
     ctest --preset release -j "$(nproc)"
     build_debug
     ctest --preset debug -j "$(nproc)" -L '^(unit|mpi)$'
+    build_asan
+    ctest --preset asan -j "$(nproc)" -L '^(unit|cli)$'
+    fuzz_scene_loader
     ;;
   *)
     echo "usage: bash quickstart.sh demo|test" >&2

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -273,6 +274,21 @@ force = [0, 1, 0]
   for (const auto& node : scene.fixes[3].nodes.nodes) EXPECT_EQ(node.k, 0);
   EXPECT_EQ(node_pairs(scene.loads[0].nodes),
             (std::set<std::pair<int, int>>{{4, 5}, {5, 5}, {4, 6}, {5, 6}}));
+}
+
+// Found by fuzzing (tests/fuzz): the disk tested every node of the grid, so a small disk on a
+// 10^5 x 10^5 grid took 10^10 tests (and --set grid.nodes=[2e9,2e9] never finished).
+TEST(Scene, ADiskCostsItsOwnNodesNotTheGrids) {
+  SceneText text;
+  text.grid = "nodes = [100000, 100000]\nsize = [10.0, 10.0]\n";
+  text.tail = "[[fix]]\nregion = { disk = { center = [50000, 99999], radius = 1.5 } }\n";
+  const auto start = std::chrono::steady_clock::now();
+  const Scene scene = parse(text);
+  const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
+  EXPECT_EQ(node_pairs(scene.fixes[0].nodes),
+            (std::set<std::pair<int, int>>{{49999, 99998}, {50000, 99998}, {50001, 99998},
+                                           {49999, 99999}, {50000, 99999}, {50001, 99999}}));
+  EXPECT_LT(elapsed.count(), 1.0);
 }
 
 TEST(Scene, PositiveDefinitenessIsAWarningNotAnError) {
