@@ -34,6 +34,10 @@ REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SCENE = os.path.join(REPO, "scenes", "s1_clothesline.toml")
 # 24 x 24 nodes, 3000 steps: a few seconds a run, 121 frames and 9 checkpoints to be killed in.
 OVERRIDES = ["grid.nodes=[24,24]", "time.steps=3000", "time.output_every=25"]
+# --adaptive: the same sheet over the same 3 s in adaptive steps (docs/stability.md), its fix
+# window in seconds (a window in steps is refused there), frames every 0.025 s.
+ADAPTIVE_OVERRIDES = ["grid.nodes=[24,24]", "time={duration=3.0, output_dt=0.025}",
+                      "fix=[{nodes=[[0,0],[0,9]]}]"]
 CHECKPOINT_EVERY = 330
 SEGMENT_TIMEOUT = 300  # seconds; a segment still running then has hung
 MODES = ("random", "checkpoint", "frame")
@@ -170,7 +174,11 @@ def main():
     parser.add_argument("--trials", type=int, default=30)
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--keep", action="store_true", help="keep the trial folders")
+    parser.add_argument("--adaptive", action="store_true",
+                        help="adaptive steps instead of the fixed step")
     args = parser.parse_args()
+    if args.adaptive:
+        OVERRIDES[:] = ADAPTIVE_OVERRIDES
     rng = random.Random(args.seed)
     work = tempfile.mkdtemp(prefix="cosserat_stress_")
 
@@ -234,7 +242,7 @@ def main():
         "/positions, /time and /step byte for byte, and its XDMF file must parse and name every "
         "frame.", "",
         "`benchmarks/run_stress_restart.py --trials "
-        f"{args.trials} --seed {args.seed}`", "",
+        f"{args.trials} --seed {args.seed}{' --adaptive' if args.adaptive else ''}`", "",
         "| trials | kills | random | mid-checkpoint | mid-frame | identical | failures |",
         "|---|---|---|---|---|---|---|",
         f"| {tally['trials']} | {tally['kills']} | {kinds['random']} | {kinds['checkpoint']} | "
@@ -244,7 +252,8 @@ def main():
         "killed rank's signal).", "",
         "| trial | segments | result |", "|---|---|---|"]
     lines += [f"| {i} | {s} | {r} |" for i, s, r in rows]
-    stem = os.path.join(REPO, "benchmarks", "results", f"stress-restart-{host}-{date}")
+    kind = "stress-restart-adaptive" if args.adaptive else "stress-restart"
+    stem = os.path.join(REPO, "benchmarks", "results", f"{kind}-{host}-{date}")
     with open(stem + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines[:14]))
