@@ -309,9 +309,9 @@ int run(const RunOptions& options, int rank, int ranks) {
     if (continued)
       writer = std::make_unique<FrameWriter>(
           output, simulation.block(), *restarted_from, scene.text,
-          // Adaptive frames are at times, never after the checkpoint's state (step_loop.hpp).
-          scene.adaptive ? *restarted_from
-                         : *restarted_from - *restarted_from % scene.output_every);
+          scene.adaptive ? 0 : *restarted_from - *restarted_from % scene.output_every,
+          // Adaptive steps schedule frames in time.
+          scene.adaptive ? AdaptiveSteps(scene).frame_at_or_before(simulation.time()) : 0.0);
     else
       writer = std::make_unique<FrameWriter>(output, simulation.block(), scene.text,
                                              integrator_name(scene.integrator), COSSERAT_VERSION,

@@ -150,7 +150,8 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
 }
 
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step,
-                         const std::string& scene_text, long last_scheduled_frame)
+                         const std::string& scene_text, long last_scheduled_frame,
+                         double last_scheduled_time)
     : block_(&block),
       h5_path_(h5_path),
       xmf_path_(xdmf_path(h5_path)),
@@ -189,6 +190,10 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
     refuse(fmt::format("it holds frames up to step {}, and the checkpoint at step {} follows the "
                        "frame of step {}: the frames between would be missing",
                        steps_.empty() ? -1 : steps_.back(), step, last_scheduled_frame));
+  if (times_.back() < last_scheduled_time)
+    refuse(fmt::format("it holds frames up to t = {} s, and the checkpoint at step {} follows the "
+                       "frame of t = {} s: the frames between would be missing",
+                       times_.back(), step, last_scheduled_time));
   const auto kept = static_cast<hsize_t>(steps_.size());
   resize_series(*file_, datasets_->positions, kept, what);
   resize_series(*file_, datasets_->time, kept, what);

@@ -42,6 +42,13 @@ double AdaptiveSteps::frame_after(double time) const {
   return std::min(j * output_dt_, duration_);
 }
 
+double AdaptiveSteps::frame_at_or_before(double time) const {
+  double j = std::floor(time / output_dt_);
+  while (j > 0.0 && j * output_dt_ > time) j -= 1.0;
+  while ((j + 1.0) * output_dt_ <= time) j += 1.0;
+  return std::max(j, 0.0) * output_dt_;
+}
+
 AdaptiveSteps::Next AdaptiveSteps::next(double time, double last_dt, double estimate) const {
   double dt = std::min({scale_ * settings_.safety * estimate, settings_.max, kGrowth * last_dt});
   // The estimate is advice; only the monitor declares a run unstable (then below min).

@@ -150,6 +150,16 @@ TEST(AdaptiveSteps, FramesLandOnTheirTimes) {
   EXPECT_GT(simulation.step_index(), static_cast<long>(expected.size()));
 }
 
+// A restart finds the last frame its checkpoint follows from the time alone, as the loop put it.
+TEST(AdaptiveSteps, TheFrameBeforeATimeIsTheOneTheLoopWrote) {
+  const Scene scene = adaptive_sheet("duration = 0.05\noutput_dt = 0.007");
+  const AdaptiveSteps steps(scene);
+  EXPECT_EQ(steps.frame_at_or_before(0.0), 0.0);
+  EXPECT_EQ(steps.frame_at_or_before(0.0069), 0.0);
+  EXPECT_EQ(steps.frame_at_or_before(3 * 0.007), 3 * 0.007);
+  EXPECT_EQ(steps.frame_at_or_before(0.0489), 6 * 0.007);
+}
+
 // Safety 1 takes steps past the stable limit: the monitor trips, the run goes back to a state
 // in memory and on with a smaller step, and ends where a safe run ends, to the integrator's
 // error (measured 5.7e-7 m against safety 0.25, on a sheet 2 m wide; an instability that had

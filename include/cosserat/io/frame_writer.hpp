@@ -36,10 +36,12 @@ class FrameWriter {
   // Reopens the output of an earlier run to continue it after a restart from `step`: the
   // frames up to that step are kept, later ones (written after the checkpoint) dropped. The file
   // must be that run's: written for `scene_text` on this grid, holding every frame up to
-  // `last_scheduled_frame`, the last one the schedule put at or before `step`; else it throws
-  // before changing anything.
+  // `last_scheduled_frame`, the last one the schedule put at or before `step` (with adaptive
+  // steps, whose frames are scheduled in time, up to `last_scheduled_time` instead); else it
+  // throws before changing anything.
   FrameWriter(const std::string& h5_path, const Block& block, long step,
-              const std::string& scene_text, long last_scheduled_frame);
+              const std::string& scene_text, long last_scheduled_frame,
+              double last_scheduled_time = 0.0);
 
   ~FrameWriter();
   FrameWriter(const FrameWriter&) = delete;

@@ -42,6 +42,9 @@ class AdaptiveSteps {
 
   double scale() const { return scale_; }
 
+  // The last frame time at or before `time`: j x output_dt (0 for the first frame).
+  double frame_at_or_before(double time) const;
+
  private:
   // The first frame time after `time`: j x output_dt, or the duration.
   double frame_after(double time) const;
