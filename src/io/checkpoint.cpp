@@ -148,16 +148,14 @@ std::optional<std::string> check_header(const hdf5::File& file, const std::strin
   return std::nullopt;
 }
 
-// Adaptive steps: where the run stands in time, the step that ended there, tc-verlet's previous
-// step and what roll-backs left of the estimate.
+// Adaptive steps: where the run stands in time, the step that ended there (tc-verlet's previous
+// step) and what roll-backs left of the estimate.
 struct AdaptiveState {
   double time = 0.0, last_dt = 0.0, scale = 1.0;
-  std::vector<double> scalars;
 };
 
 std::optional<std::string> read_adaptive_state(const hdf5::File& file, const std::string& path,
-                                               const Scene& scene, Stepper& stepper,
-                                               AdaptiveState& state) {
+                                               const Scene& scene, AdaptiveState& state) {
   state.time = file.read_double_attribute("time");
   state.last_dt = file.read_double_attribute("last_dt");
   state.scale = file.read_double_attribute("adaptive_scale");
@@ -169,12 +167,6 @@ std::optional<std::string> read_adaptive_state(const hdf5::File& file, const std
     return fmt::format("checkpoint '{}': its last step {} s or its roll-back factor {} is not "
                        "a step or a factor in (0, 1]",
                        path, state.last_dt, state.scale);
-  for (const Stepper::StateScalar& x : stepper.state_scalars()) {
-    const double value = file.read_double_attribute(x.name);
-    if (!(value > 0.0 && std::isfinite(value)))
-      return fmt::format("checkpoint '{}': its {} is {}, not a step", path, x.name, value);
-    state.scalars.push_back(value);
-  }
   return std::nullopt;
 }
 
@@ -290,8 +282,6 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
       // Adaptive steps continue bitwise only from the same step history and roll-back factor.
       file.write_attribute("last_dt", simulation.stepper().last_dt());
       file.write_attribute("adaptive_scale", adaptive_scale.value_or(1.0));
-      for (const Stepper::StateScalar& x : simulation.stepper().state_scalars())
-        file.write_attribute(x.name, *x.value);
     }
     const std::vector<hsize_t> shape{static_cast<hsize_t>(b.m), static_cast<hsize_t>(b.n), 3};
     for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
@@ -331,7 +321,7 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
     // alike, before the collective reads of the fields.
     problem = check_header(file, path, scene, step, peak);
     if (!problem && scene.adaptive)
-      problem = read_adaptive_state(file, path, scene, simulation.stepper(), adaptive);
+      problem = read_adaptive_state(file, path, scene, adaptive);
     for (const Stepper::StateField& f : simulation.stepper().state_fields()) {
       if (problem) break;
       const Handle dataset = file.open(H5Dopen2(file.get(), ("/" + f.name).c_str(), H5P_DEFAULT),
@@ -350,8 +340,6 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
 
   simulation.stepper().constraints().restore(constraints);
   if (scene.adaptive) {
-    const std::vector<Stepper::StateScalar> scalars = simulation.stepper().state_scalars();
-    for (std::size_t i = 0; i < scalars.size(); ++i) *scalars[i].value = adaptive.scalars[i];
     simulation.stepper().resume(step, adaptive.time, adaptive.last_dt);
     if (adaptive_scale != nullptr) *adaptive_scale = adaptive.scale;
   } else {

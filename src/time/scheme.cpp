@@ -35,7 +35,8 @@ void Scheme::accept() {
   positions_.swap(next_positions_);
 }
 
-void Scheme::resume() {
+void Scheme::resume(double last_dt) {
+  context_.dt = last_dt;
   state_changed();
   context_.halo.exchange(positions_);
 }

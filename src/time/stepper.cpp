@@ -64,17 +64,14 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
 }
 
 Stepper::Snapshot Stepper::snapshot() {
-  Snapshot s{step_, time_, dt_, {}, {}, constraints_.state()};
+  Snapshot s{step_, time_, dt_, {}, constraints_.state()};
   for (const StateField& f : scheme_->state_fields()) s.fields.push_back(*f.field);
-  for (const StateScalar& x : scheme_->state_scalars()) s.scalars.push_back(*x.value);
   return s;
 }
 
 void Stepper::restore(const Snapshot& s) {
   const std::vector<StateField> fields = scheme_->state_fields();
   for (std::size_t i = 0; i < fields.size(); ++i) *fields[i].field = s.fields[i];
-  const std::vector<StateScalar> scalars = scheme_->state_scalars();
-  for (std::size_t i = 0; i < scalars.size(); ++i) *scalars[i].value = s.scalars[i];
   constraints_.restore(s.constraints);
   resume(s.step, s.time, s.last_dt);
 }
@@ -141,7 +138,7 @@ void Stepper::resume(long step, double time, double last_dt) {
   step_ = step;
   time_ = time;
   dt_ = last_dt;
-  scheme_->resume();
+  scheme_->resume(last_dt);
 }
 
 }  // namespace cosserat

@@ -286,7 +286,7 @@ class FirstCheckpoint : public StepObserver {
   bool written_ = false;
 };
 
-// Adaptive steps restart bitwise: the checkpoint holds the last step, tc-verlet's previous step
+// Adaptive steps restart bitwise: the checkpoint holds the last step (tc-verlet's previous step)
 // and what roll-backs left of the estimate, and the restarted run holds the same states to roll
 // back to. Checkpoints every 150 steps, the first kept; restarted on another split.
 TEST_F(Restart, AdaptiveStepsContinueBitwise) {

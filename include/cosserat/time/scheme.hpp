@@ -46,11 +46,6 @@ class Scheme {
     std::string name;
     Field<Vec3>* field;
   };
-  // A number that carries state the same way (tc-verlet's previous step).
-  struct StateScalar {
-    std::string name;
-    double* value;
-  };
 
   Scheme(const StepContext& context, const Field<Vec3>& positions);
   virtual ~Scheme() = default;
@@ -72,8 +67,8 @@ class Scheme {
   // The proposed state, its positions' ghosts exchanged, becomes the current one.
   void accept();
 
-  // After a restart overwrote the state fields.
-  void resume();
+  // After a restart overwrote the state fields: `last_dt` is the step that ended at the state.
+  void resume(double last_dt);
 
   const Field<Vec3>& positions() const { return positions_; }
   Field<Vec3>& next_positions() { return next_positions_; }
@@ -86,7 +81,6 @@ class Scheme {
 
   // Together with the step index and the constraints' state, all a restart needs.
   virtual std::vector<StateField> state_fields() = 0;
-  virtual std::vector<StateScalar> state_scalars() { return {}; }
 
   // The next step's size and start time: a fixed step sets them once, adaptive steps before
   // every step.
@@ -107,7 +101,8 @@ class Scheme {
   // Whether advance() already exchanged the new positions' ghosts (velocity-verlet reads
   // forces there), so accept() need not.
   virtual bool exchanged_next_positions() const { return false; }
-  // Called by resume(), for families that cache something derived from the state.
+  // Called by resume(), after context_.dt became the step that ended at the state, for
+  // families that cache something derived from the state.
   virtual void state_changed() {}
 
   // Where the fluid term's normals go, or null when the scene has no fluid.
@@ -131,17 +126,19 @@ class VerletFamily : public Scheme {
   // The backward difference (r − r⁻)/Δt: the velocity half a step back.
   const Field<Vec3>& velocities() override;
   std::vector<StateField> state_fields() override;
-  std::vector<StateScalar> state_scalars() override { return {{"dt_previous", &dt_previous_}}; }
 
  protected:
   void start(Field<Vec3> velocities) override;
   // The new positions from (rⁿ, rⁿ⁻¹): verlet-lagged's or the centred step.
   virtual std::optional<std::string> propose(long step);
   void accept_state() override;
-  void state_changed() override { velocities_current_ = false; }
+  void state_changed() override {
+    velocities_current_ = false;
+    dt_previous_ = context_.dt;
+  }
 
   Field<Vec3> previous_positions_;  // rⁿ⁻¹
-  double dt_previous_;              // Δtₙ₋₁; equal to Δtₙ with a fixed step
+  double dt_previous_;              // Δtₙ₋₁: the Stepper's last step
 
  private:
   void centred_step(long step);

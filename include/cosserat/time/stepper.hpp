@@ -70,7 +70,6 @@ class Stepper {
     double time = 0.0;
     double last_dt = 0.0;
     std::vector<Field<Vec3>> fields;
-    std::vector<double> scalars;
     std::vector<Constraints::NodeState> constraints;
   };
   Snapshot snapshot();
@@ -80,12 +79,10 @@ class Stepper {
   void add_action(std::unique_ptr<StepAction> action) { actions_.push_back(std::move(action)); }
 
   using StateField = Scheme::StateField;
-  using StateScalar = Scheme::StateScalar;
-  // The fields and numbers that carry the scheme's state from one step to the next: together
-  // with the step index, the time and the constraints' state, all a restart needs to continue
+  // The fields that carry the scheme's state from one step to the next: together with the step
+  // index, the time, the last step and the constraints' state, all a restart needs to continue
   // bitwise.
   std::vector<StateField> state_fields() { return scheme_->state_fields(); }
-  std::vector<StateScalar> state_scalars() { return scheme_->state_scalars(); }
   Constraints& constraints() { return constraints_; }
   // Continues from `step` after the state was overwritten; with a fixed step the time is
   // step x dt, adaptive steps give the time and the size of the step that ended there.
