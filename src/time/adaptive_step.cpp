@@ -33,20 +33,21 @@ AdaptiveSteps::AdaptiveSteps(const Scene& scene, double scale)
       output_dt_(scene.output_dt),
       scale_(scale) {}
 
+// The largest j ≥ 0 with j x output_dt ≤ time, found from the products themselves, which are
+// the frame times, so that a time that landed on a frame is never taken for just before it.
+double AdaptiveSteps::frame_index(double time) const {
+  double j = std::max(std::floor(time / output_dt_), 0.0);
+  while (j > 0.0 && j * output_dt_ > time) j -= 1.0;
+  while ((j + 1.0) * output_dt_ <= time) j += 1.0;
+  return j;
+}
+
 double AdaptiveSteps::frame_after(double time) const {
-  // The smallest j with j x output_dt > time, found from the products themselves, which are
-  // the frame times, so that a time that landed on a frame is never taken for just before it.
-  double j = std::floor(time / output_dt_);
-  while (j * output_dt_ <= time) j += 1.0;
-  while (j > 1.0 && (j - 1.0) * output_dt_ > time) j -= 1.0;
-  return std::min(j * output_dt_, duration_);
+  return std::min((frame_index(time) + 1.0) * output_dt_, duration_);
 }
 
 double AdaptiveSteps::frame_at_or_before(double time) const {
-  double j = std::floor(time / output_dt_);
-  while (j > 0.0 && j * output_dt_ > time) j -= 1.0;
-  while ((j + 1.0) * output_dt_ <= time) j += 1.0;
-  return std::max(j, 0.0) * output_dt_;
+  return frame_index(time) * output_dt_;
 }
 
 AdaptiveSteps::Next AdaptiveSteps::next(double time, double last_dt, double estimate) const {

@@ -46,6 +46,7 @@ class AdaptiveSteps {
   double frame_at_or_before(double time) const;
 
  private:
+  double frame_index(double time) const;
   // The first frame time after `time`: j x output_dt, or the duration.
   double frame_after(double time) const;
 
