@@ -13,6 +13,7 @@
 #include "cosserat/model/wave_speed.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/simulation.hpp"
+#include "support/sheets.hpp"
 
 namespace cosserat::testing {
 
@@ -99,26 +100,11 @@ inline Scene semi_implicit_odd_grid_scene() {
   return scene;
 }
 
-// Adaptive steps that roll back: a 24 x 24 sheet of 2 m whose step bending sets, where the CFL
-// estimate is 1/0.61 of Verlet's limit, at safety 1, so that the monitor trips and the run goes
-// back (tests/unit/test_adaptive_steps.cpp); a load on a disk straddling the block borders for
-// its first 0.05 s, and two corners held.
+// Adaptive steps that roll back: the bending sheet (support/sheets.hpp) at safety 1, so that the
+// monitor trips and the run goes back (tests/unit/test_adaptive_steps.cpp); a load on a disk
+// straddling the block borders for its first 0.05 s, and two corners held.
 inline Scene rolling_back_scene(Integrator integrator) {
-  Scene scene = parse_scene(R"(
-[grid]
-nodes = [24, 24]
-size = [2.0, 2.0]
-origin = [0.0, 0.0, 0.0]
-u = [1.0, 0.0, 0.0]
-v = [0.0, 0.0, 1.0]
-[material]
-mass = 0.4
-zeta = 100.0
-xi = 1.0
-phi = 0.001
-[environment]
-gravity = [0.0, -9.8, 0.0]
-damping = 0.2
+  Scene scene = parse_scene(bending_sheet_text() + R"(
 [time]
 duration = 0.2
 output_dt = 0.1
