@@ -1,0 +1,84 @@
+#pragma once
+// Cloth against rigid solids (CONTACT.md §2–§4): the solids of a scene, their motion, and the
+// detection and response applied to a proposed step. Works on this rank's block: contacts on
+// owned nodes and owned cells, the free bodies' impulse sums exact and independent of the
+// decomposition, so every rank moves every body identically.
+
+#include <cstddef>
+#include <vector>
+
+#include "cosserat/contact/geometry.hpp"
+#include "cosserat/contact/solid.hpp"
+#include "cosserat/grid/block.hpp"
+#include "cosserat/grid/halo.hpp"
+
+namespace cosserat {
+
+// A node whose velocity contact changed: the scheme carries `velocity` into its next step.
+struct NodeVelocity {
+  int k, l;
+  Vec3 velocity;
+};
+
+// The state of a solid at one time.
+struct SolidState {
+  Pose pose;
+  Vec3 velocity;          // of the frame's origin (the centre of mass of a free body)
+  Vec3 angular_velocity;  // world frame
+};
+
+// What one step's response found, on all ranks.
+struct ContactStats {
+  double max_penetration = 0.0;  // deepest any owned node sat inside a solid after the response, m
+  long contacts = 0;             // nodes the response moved
+};
+
+class Contact {
+ public:
+  // `node_mass` is the lumped mass of every node (kg), `spacing` the smaller grid spacing.
+  Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo, double node_mass,
+          const Vec3& gravity, double spacing);
+  ~Contact();
+  Contact(const Contact&) = delete;
+  Contact& operator=(const Contact&) = delete;
+
+  std::size_t size() const { return solids_.size(); }
+  const SolidSpec& spec(std::size_t i) const { return solids_[i].spec; }
+  const SolidGeometry& geometry(std::size_t i) const { return solids_[i].geometry; }
+  // At the current (last accepted) time.
+  const SolidState& state(std::size_t i) const { return solids_[i].state; }
+
+  // The step from `time` to `time + dt` proposed `next` (owned nodes; ghosts may be stale)
+  // from `current` (ghosts valid), with `next_velocities` when the scheme carries velocities,
+  // else the velocity is (next − current)/dt. Moves owned nodes of `next` out of every solid,
+  // exchanges its ghosts, lists the changed velocities in `corrected`, and proposes the
+  // bodies' state at time + dt. Collective over the block's ranks.
+  ContactStats respond(double time, double dt, const Field<Vec3>& current, Field<Vec3>& next,
+                       const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected);
+  // The proposed step was accepted: the bodies take their proposed state.
+  void accept();
+
+  // Every solid's state (and the pushes still on) as numbers, for roll-backs and checkpoints;
+  // restore() takes what state_vector() gave.
+  std::vector<double> state_vector() const;
+  void restore(const std::vector<double>& values);
+
+ private:
+  struct Solid {
+    SolidSpec spec;
+    SolidGeometry geometry;
+    Vec3 inertia_per_mass;  // free bodies: principal moments / mass, body frame
+    SolidState state;       // at the last accepted time
+    SolidState proposed;    // at the end of the step being proposed
+    bool pushing = false;   // free bodies: the constant push still acts
+    bool proposed_pushing = false;
+  };
+  std::vector<Solid> solids_;
+  const Block* block_;
+  Halo* halo_;
+  double node_mass_;
+  Vec3 gravity_;
+  double spacing_;
+};
+
+}  // namespace cosserat
