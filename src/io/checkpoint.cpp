@@ -289,6 +289,11 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
       file.write_block(dataset.get(), *f.field, {}, "write /" + f.name);
     }
     write_constraints(file, simulation.stepper().constraints(), b.comm);
+    // The solids' motion and what contact found so far: replicated, so every rank writes the
+    // same numbers.
+    const std::vector<std::vector<double>> actions = simulation.stepper().action_states();
+    for (std::size_t i = 0; i < actions.size(); ++i)
+      file.write_attribute(fmt::format("action_state_{}", i), actions[i]);
     file.flush();
   }
   // Every rank has closed the file; only then does it replace the previous checkpoint.
@@ -314,6 +319,7 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
   long step = 0;
   std::optional<double> peak;
   std::vector<Constraints::NodeState> constraints;
+  std::vector<std::vector<double>> actions;
   AdaptiveState adaptive;
   try {
     const hdf5::File file(path, b.comm, hdf5::File::Mode::read);
@@ -330,6 +336,22 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
       if (!problem) file.read_block(dataset.get(), *f.field, "read /" + f.name);
     }
     if (!problem) constraints = read_constraints(file);
+    const std::size_t count = simulation.stepper().action_states().size();
+    for (std::size_t i = 0; i < count && !problem; ++i) {
+      const std::string name = fmt::format("action_state_{}", i);
+      if (!file.has_attribute(name)) {
+        problem = fmt::format("cannot restart from '{}': it holds no state of the solids ({}); "
+                              "it was written for a scene without them", path, name);
+        break;
+      }
+      actions.push_back(file.read_doubles_attribute(name));
+      for (const double x : actions.back())
+        if (!std::isfinite(x)) {
+          problem = fmt::format("cannot restart from '{}': the solids' state ({}) holds a value "
+                                "that is not finite", path, name);
+          break;
+        }
+    }
   } catch (const std::runtime_error& e) {
     problem = fmt::format("cannot restart from '{}': {}", path, e.what());
   }
@@ -339,6 +361,11 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
   if (const auto refused = first_of_any_rank(problem, b.comm)) throw CheckpointError(*refused);
 
   simulation.stepper().constraints().restore(constraints);
+  try {
+    simulation.stepper().restore_action_states(actions);
+  } catch (const std::invalid_argument& e) {
+    throw CheckpointError(fmt::format("cannot restart from '{}': {}", path, e.what()));
+  }
   if (scene.adaptive) {
     simulation.stepper().resume(step, adaptive.time, adaptive.last_dt);
     if (adaptive_scale != nullptr) *adaptive_scale = adaptive.scale;

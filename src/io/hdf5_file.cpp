@@ -97,6 +97,19 @@ void File::write_attribute(const std::string& name, double value) const {
   write_scalar(*this, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
 }
 
+void File::write_attribute(const std::string& name, const std::vector<double>& values) const {
+  const std::string what = fmt::format("write attribute '{}'", name);
+  const htri_t exists = H5Aexists(get(), name.c_str());
+  check(exists, what + " (look up)");
+  if (exists > 0) check(H5Adelete(get(), name.c_str()), what + " (delete old)");
+  const hsize_t size = values.size();
+  const Handle space = open(H5Screate_simple(1, &size, nullptr), H5Sclose, what);
+  const Handle attribute = open(
+      H5Acreate2(get(), name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+      H5Aclose, what);
+  check(H5Awrite(attribute.get(), H5T_NATIVE_DOUBLE, values.data()), what);
+}
+
 namespace {
 
 Handle open_attribute(const File& file, const std::string& name, const std::string& what) {
@@ -128,6 +141,17 @@ bool File::has_attribute(const std::string& name) const {
   const htri_t exists = H5Aexists(file_.get(), name.c_str());
   check(exists, fmt::format("look for attribute '{}'", name));
   return exists > 0;
+}
+
+std::vector<double> File::read_doubles_attribute(const std::string& name) const {
+  const std::string what = fmt::format("read attribute '{}'", name);
+  const Handle attribute = open_attribute(*this, name, what);
+  const Handle space = open(H5Aget_space(attribute.get()), H5Sclose, what);
+  const hssize_t size = H5Sget_simple_extent_npoints(space.get());
+  check(static_cast<hid_t>(size), what + " (size)");
+  std::vector<double> values(static_cast<std::size_t>(size));
+  check(H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, values.data()), what);
+  return values;
 }
 
 double File::read_double_attribute(const std::string& name) const {

@@ -10,6 +10,7 @@
 #include <exception>
 #include <span>
 #include <string>
+#include <vector>
 #include <utility>
 
 #include "cosserat/grid/block.hpp"
@@ -78,10 +79,12 @@ class File {
   void write_attribute(const std::string& name, const std::string& value) const;
   void write_attribute(const std::string& name, std::int64_t value) const;
   void write_attribute(const std::string& name, double value) const;
+  void write_attribute(const std::string& name, const std::vector<double>& values) const;
   std::string read_string_attribute(const std::string& name) const;
   bool has_attribute(const std::string& name) const;
   std::int64_t read_int_attribute(const std::string& name) const;
   double read_double_attribute(const std::string& name) const;
+  std::vector<double> read_doubles_attribute(const std::string& name) const;
 
   // Transfer property lists for collective and independent I/O.
   hid_t collective() const { return collective_.get(); }

@@ -79,6 +79,14 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   summary.linear_solves = simulation.stepper().linear_solves();
   summary.rest = loop.rest;
   summary.adaptive = loop.adaptive;
+  if (const Contact* contact = simulation.contact()) {
+    summary.contact = simulation.contact_summary();
+    static constexpr const char* motions[] = {"fixed", "kinematic", "free"};
+    for (std::size_t i = 0; i < contact->size(); ++i)
+      summary.solids.push_back({contact->spec(i).name,
+                                motions[static_cast<int>(contact->spec(i).motion)],
+                                contact->state(i)});
+  }
   return summary;
 }
 
@@ -109,6 +117,29 @@ std::string to_json(const RunSummary& s) {
                            json_number(a->smallest_dt), json_number(a->largest_dt),
                            a->rollbacks);
   }
+  const auto vector = [](const Vec3& v) {
+    return fmt::format("[{}, {}, {}]", json_number(v.x), json_number(v.y), json_number(v.z));
+  };
+  std::string solids = "[]";
+  if (!s.solids.empty()) {
+    solids = "[";
+    for (std::size_t i = 0; i < s.solids.size(); ++i) {
+      const SolidState& st = s.solids[i].state;
+      const Quaternion& q = st.pose.orientation;
+      solids += fmt::format(
+          R"({}{{"name": {}, "motion": {}, "position": {}, "orientation": [{}, {}, {}, {}], )"
+          R"("velocity": {}, "angular_velocity": {}}})",
+          i == 0 ? "\n    " : ",\n    ", json_string(s.solids[i].name),
+          json_string(s.solids[i].motion), vector(st.pose.position), json_number(q.w),
+          json_number(q.x), json_number(q.y), json_number(q.z), vector(st.velocity),
+          vector(st.angular_velocity));
+    }
+    solids += "\n  ]";
+  }
+  const std::string max_penetration =
+      s.contact ? json_number(s.contact->max_penetration) : "null";
+  const std::string max_contacts =
+      s.contact ? fmt::format("{}", s.contact->max_contacts) : "null";
   return fmt::format(
       R"({{
   "scene": {},
@@ -136,7 +167,10 @@ std::string to_json(const RunSummary& s) {
   "output": {},
   "linear_solves": {},
   "rest": {},
-  "adaptive": {}
+  "adaptive": {},
+  "max_penetration": {},
+  "max_contacts": {},
+  "solids": {}
 }}
 )",
       json_string(s.scene), s.m, s.n, s.ranks, s.threads, s.parts_k, s.parts_l,
@@ -144,7 +178,8 @@ std::string to_json(const RunSummary& s) {
       json_number(s.wall_seconds), json_number(s.node_steps_per_second),
       json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,
       json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
-      json_number(s.elastic_energy), json_number(s.gravitational_energy), json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest, adaptive);
+      json_number(s.elastic_energy), json_number(s.gravitational_energy), json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest, adaptive,
+      max_penetration, max_contacts, solids);
 }
 
 void write_summary(const std::string& path, const RunSummary& summary) {

@@ -20,6 +20,9 @@ class VelocityScheme : public Scheme {
   Field<Vec3>* next_velocities() override { return &next_velocity_; }
   const Field<Vec3>& velocities() override { return velocity_; }
   std::vector<StateField> state_fields() override;
+  void set_velocities(const std::vector<NodeVelocity>& velocities) override {
+    for (const NodeVelocity& v : velocities) velocity_(v.k, v.l) = v.velocity;
+  }
 
  protected:
   void accept_state() override { velocity_.swap(next_velocity_); }

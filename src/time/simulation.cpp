@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "cosserat/grid/reduce.hpp"
@@ -28,6 +29,41 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
   return v;
 }
 
+// CONTACT.md: the scene's solids against every proposed step, whatever the scheme; the run's
+// maxima kept over accepted steps.
+class Simulation::ContactAction final : public StepAction {
+ public:
+  explicit ContactAction(Contact& contact) : contact_(&contact) {}
+
+  void apply(ProposedStep& p) override {
+    last_ = contact_->respond(p.time, p.dt, p.positions, p.next_positions, p.next_velocities,
+                              p.velocities);
+  }
+  void accepted() override {
+    contact_->accept();
+    summary_.max_penetration = std::max(summary_.max_penetration, last_.max_penetration);
+    summary_.max_contacts = std::max(summary_.max_contacts, last_.contacts);
+  }
+  std::vector<double> state() const override {
+    std::vector<double> values = contact_->state_vector();
+    values.push_back(summary_.max_penetration);
+    values.push_back(static_cast<double>(summary_.max_contacts));
+    return values;
+  }
+  void restore(const std::vector<double>& values) override {
+    if (values.size() < 2) throw std::invalid_argument("contact state: too few numbers");
+    contact_->restore({values.begin(), values.end() - 2});
+    summary_.max_penetration = values[values.size() - 2];
+    summary_.max_contacts = static_cast<long>(values.back());
+  }
+  const ContactSummary& summary() const { return summary_; }
+
+ private:
+  Contact* contact_;
+  ContactStats last_;
+  ContactSummary summary_;
+};
+
 Simulation::Simulation(const Scene& scene, MPI_Comm comm, const SchemeFactory& make)
     : Simulation(scene, comm, Decomposition::choose(scene.m, scene.n, size_of(comm)), make) {}
 
@@ -38,8 +74,22 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
       block_(decomposition_.block(rank_in(comm), comm)),
       halo_(decomposition_, block_, rank_in(comm)),
       dynamics_(scene, block_, rest_positions(scene, block_)),
+      contact_(scene.solids.empty()
+                   ? nullptr
+                   : std::make_unique<Contact>(scene.solids, block_, halo_, dynamics_.node_mass(),
+                                               scene.gravity, std::min(scene.h1(), scene.h2()))),
       stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),
-               initial_velocities(scene, block_), make) {}
+               initial_velocities(scene, block_), make) {
+  if (contact_) {
+    auto action = std::make_unique<ContactAction>(*contact_);
+    contact_action_ = action.get();
+    stepper_.add_action(std::move(action));
+  }
+}
+
+ContactSummary Simulation::contact_summary() const {
+  return contact_action_ ? contact_action_->summary() : ContactSummary{};
+}
 
 double Simulation::memory_bytes(const Block& block, Integrator integrator) {
   const double ghosted_nodes = static_cast<double>(block.local_size());

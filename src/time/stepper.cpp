@@ -47,16 +47,16 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
   if (auto solver_failure = scheme_->advance(step_)) {
     return Instability{step_ + 1, end_time, -1, -1, false, std::move(solver_failure), {}};
   }
-  if (!actions_.empty()) {
-    ProposedStep proposed{step_ + 1, dt, scheme_->positions(), scheme_->next_positions(),
-                          scheme_->next_velocities()};
-    for (const auto& action : actions_) action->apply(proposed);
-  }
+  ProposedStep proposed{step_ + 1, dt, scheme_->positions(), scheme_->next_positions(),
+                        scheme_->next_velocities(), time_, {}};
+  for (const auto& action : actions_) action->apply(proposed);
   // The check compares each node's move with its neighbours', across block borders too; the
   // accepted positions are then where the next step's forces are read.
   scheme_->exchange_next_positions(!actions_.empty());
   if (auto failure = check(scheme_->next_positions(), end_time)) return failure;
   scheme_->accept();
+  if (!proposed.velocities.empty()) scheme_->set_velocities(proposed.velocities);
+  for (const auto& action : actions_) action->accepted();
   ++step_;
   dt_ = dt;
   time_ = end_time;
@@ -64,15 +64,27 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
 }
 
 Stepper::Snapshot Stepper::snapshot() {
-  Snapshot s{step_, time_, dt_, {}, constraints_.state()};
+  Snapshot s{step_, time_, dt_, {}, constraints_.state(), action_states()};
   for (const StateField& f : scheme_->state_fields()) s.fields.push_back(*f.field);
   return s;
+}
+
+std::vector<std::vector<double>> Stepper::action_states() const {
+  std::vector<std::vector<double>> states;
+  for (const auto& action : actions_) states.push_back(action->state());
+  return states;
+}
+
+void Stepper::restore_action_states(const std::vector<std::vector<double>>& states) {
+  for (std::size_t i = 0; i < actions_.size() && i < states.size(); ++i)
+    actions_[i]->restore(states[i]);
 }
 
 void Stepper::restore(const Snapshot& s) {
   const std::vector<StateField> fields = scheme_->state_fields();
   for (std::size_t i = 0; i < fields.size(); ++i) *fields[i].field = s.fields[i];
   constraints_.restore(s.constraints);
+  restore_action_states(s.actions);
   resume(s.step, s.time, s.last_dt);
 }
 

@@ -95,6 +95,12 @@ void VerletFamily::accept_state() {
   dt_previous_ = context_.dt;
 }
 
+void VerletFamily::set_velocities(const std::vector<NodeVelocity>& velocities) {
+  for (const NodeVelocity& v : velocities)
+    previous_positions_(v.k, v.l) = positions_(v.k, v.l) - dt_previous_ * v.velocity;
+  velocities_current_ = false;
+}
+
 const Field<Vec3>& VerletFamily::velocities() {
   if (!velocities_current_) {
     const double dt = dt_previous_;

@@ -121,6 +121,47 @@ end_time = 0.05
   return scene;
 }
 
+// Contact with a free body (CONTACT.md §4): a 13 x 11 sheet held at two corners, a free box
+// thrown down onto it off-centre and spinning, a fixed sphere under the sheet whose cells it
+// presses into, and a floor; 160 steps of 1 ms, long enough for both solids to touch the
+// sheet across the block borders of every split.
+inline Scene free_body_scene(Integrator integrator) {
+  Scene scene = flat_sheet(13, 11);
+  scene.size1 = 1.2;
+  scene.size2 = 1.0;
+  scene.origin = {-0.6, 0.0, -0.5};
+  scene.material.mass = 0.25;
+  scene.material.zeta = {20.0, 0.0, 20.0};
+  scene.material.xi = {1e-3, 0.0, 1e-3};
+  scene.material.phi = {0.0, 0.0, 0.0};
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.integrator = integrator;
+  scene.steps = 160;
+  scene.fixes.push_back(fix_nodes({{0, 0}, {12, 10}}));
+  SolidSpec box;
+  box.name = "box";
+  box.shape.kind = ShapeKind::box;
+  box.shape.half_extents = {0.12, 0.08, 0.1};
+  box.pose = {{0.07, 0.2, -0.03}, from_axis_angle({1.0, 2.0, 0.5}, 0.4)};
+  box.motion = SolidMotion::free;
+  box.body.mass = 0.3;
+  box.body.initial_velocity = {0.1, -1.5, 0.05};
+  box.body.initial_angular_velocity = {0.5, -1.0, 2.0};
+  box.body.drag = 0.05;
+  box.friction = 0.4;
+  box.restitution = 0.3;
+  box.thickness = 2e-3;
+  scene.solids.push_back(box);
+  SolidSpec ball;
+  ball.name = "ball";
+  ball.shape.kind = ShapeKind::sphere;
+  ball.shape.radius = 0.04;
+  ball.pose.position = {-0.25, -0.06, 0.2};
+  ball.thickness = 2e-3;
+  scene.solids.push_back(ball);
+  return scene;
+}
+
 // Number of owned nodes, over all ranks, where `field` differs in any bit from `reference`,
 // a field of the whole grid.
 inline long differing_nodes(const Field<Vec3>& field, const Field<Vec3>& reference) {

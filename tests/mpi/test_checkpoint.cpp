@@ -319,5 +319,22 @@ TEST_F(Restart, AdaptiveStepsContinueBitwise) {
   }
 }
 
+// With a free body in contact, the checkpoint also holds the solids' state: a restart on
+// another split, and on one rank, continues the cloth and the body bitwise.
+TEST_F(Restart, ContactWithAFreeBodyContinuesBitwise) {
+  const Scene scene = testing::free_body_scene(Integrator::verlet);
+  Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
+  checkpoint_at_half(scene);
+  const auto splits = all_splits(scene.m, scene.n, world_size());
+  Simulation restarted(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
+  continue_to_end(restarted, scene);
+  EXPECT_EQ(differing_nodes(restarted.positions(), uninterrupted.positions()), 0);
+  EXPECT_EQ(restarted.contact()->state_vector(), uninterrupted.contact()->state_vector());
+  Simulation alone(scene, MPI_COMM_SELF, any_scheme);
+  continue_to_end(alone, scene);
+  EXPECT_EQ(differing_nodes(alone.positions(), uninterrupted.positions()), 0);
+}
+
 }  // namespace
 }  // namespace cosserat

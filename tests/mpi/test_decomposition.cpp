@@ -201,5 +201,31 @@ TEST(DecompositionInvariance, AdaptiveStepsAndTheirRollBacksFollowTheOneBlockRun
   }
 }
 
+// Contact with a free body (CONTACT.md §4): contacts on owned nodes and cells, the body's
+// impulse sums in one global order, so the cloth and the body follow the one-block run bitwise
+// on every split, for a scheme of each state kind.
+TEST(DecompositionInvariance, ContactWithAFreeBodyFollowsTheOneBlockRun) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
+    const Scene scene = testing::free_body_scene(integrator);
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+    ASSERT_TRUE(testing::advance(reference, scene.steps));
+    ASSERT_GT(reference.contact_summary().max_contacts, 0);
+    const std::vector<double> body = reference.contact()->state_vector();
+    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+      ASSERT_TRUE(testing::advance(sim, scene.steps));
+      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+          << integrator_name(integrator) << ", split " << split_name(d);
+      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+          << integrator_name(integrator) << ", split " << split_name(d);
+      EXPECT_EQ(sim.contact()->state_vector(), body)
+          << integrator_name(integrator) << ", split " << split_name(d);
+      EXPECT_EQ(sim.contact_summary().max_contacts, reference.contact_summary().max_contacts);
+      EXPECT_EQ(sim.contact_summary().max_penetration,
+                reference.contact_summary().max_penetration);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace cosserat

@@ -48,14 +48,14 @@ class Contact {
   // At the current (last accepted) time.
   const SolidState& state(std::size_t i) const { return solids_[i].state; }
 
-  // The step from `time` to `time + dt` proposed `next` (owned nodes; ghosts may be stale)
-  // from `current` (ghosts valid), with `next_velocities` when the scheme carries velocities,
-  // else the velocity is (next − current)/dt. Moves owned nodes of `next` out of every solid,
-  // exchanges its ghosts, lists the changed velocities in `corrected`, and proposes the
-  // bodies' state at time + dt. Collective over the block's ranks.
+  // The step from `time` to `time + dt` proposed `next` (owned nodes) from `current` (ghosts
+  // valid), with `next_velocities` when the scheme carries velocities, else the velocity is
+  // (next − current)/dt. Moves owned nodes of `next` out of every solid (its ghosts are left
+  // stale: the caller exchanges them), lists the changed velocities in `corrected`, and
+  // proposes the solids' state at time + dt. Collective over the block's ranks.
   ContactStats respond(double time, double dt, const Field<Vec3>& current, Field<Vec3>& next,
                        const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected);
-  // The proposed step was accepted: the bodies take their proposed state.
+  // The proposed step was accepted: the solids take their proposed state.
   void accept();
 
   // Every solid's state (and the pushes still on) as numbers, for roll-backs and checkpoints;
@@ -73,12 +73,34 @@ class Contact {
     bool pushing = false;   // free bodies: the constant push still acts
     bool proposed_pushing = false;
   };
+  // One node's change by one solid, for a free body's sums (see contact.cpp).
+  struct Exchange;
+  // A cell triangle's correction (see cell_pass).
+  struct CellPush;
+
+  void propose_free(Solid& s, double dt) const;
+  Vec3 velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
+                       const Vec3& velocity, double point_mass) const;
+  void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
+              const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
+  void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
+                 std::vector<Exchange>& out);
+  void cell_pass(int pass, std::size_t solid, Field<Vec3>& next, std::vector<Exchange>& out);
+  // Whether an owned node still sits inside a solid's offset layer (any rank); the deepest
+  // any owned node sits inside a solid itself goes to `penetration`.
+  bool any_inside(const Field<Vec3>& next, double& penetration) const;
+  void apply_impulses(std::vector<Exchange>& exchanges);
+
   std::vector<Solid> solids_;
   const Block* block_;
   Halo* halo_;
   double node_mass_;
   Vec3 gravity_;
   double spacing_;
+  bool any_free_ = false;
+  Field<Vec3> velocity_;           // the nodes' velocities during a response
+  Field<unsigned char> touched_;   // nodes the response changed
+  std::vector<CellPush> cells_;    // cell_pass's triangles
 };
 
 }  // namespace cosserat

@@ -43,6 +43,14 @@ struct RunSummary {
   std::optional<LinearSolveStats> linear_solves;  // semi-implicit only
   std::optional<RestSummary> rest;                  // with --until-rest only
   std::optional<AdaptiveSummary> adaptive;          // with adaptive steps only (dt is null)
+  // With solids only (CONTACT.md §5): the run's contact maxima and each solid's final state.
+  std::optional<ContactSummary> contact;
+  struct SolidReport {
+    std::string name;
+    std::string motion;
+    SolidState state;
+  };
+  std::vector<SolidReport> solids;
 };
 
 // How a run was laid out and where it wrote, beside what its scene and step loop say.

@@ -12,6 +12,7 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
+#include "cosserat/contact/contact.hpp"
 #include "cosserat/grid/halo.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
@@ -70,6 +71,11 @@ class Scheme {
   // After a restart overwrote the state fields: `last_dt` is the step that ended at the state.
   void resume(double last_dt);
 
+  // After accept(): the listed owned nodes move on with these velocities (a contact
+  // response's, CONTACT.md §3): a scheme that carries velocities takes them, the Verlet family
+  // rewrites r⁻ so that (r − r⁻)/Δt is the given velocity.
+  virtual void set_velocities(const std::vector<NodeVelocity>& velocities) = 0;
+
   const Field<Vec3>& positions() const { return positions_; }
   Field<Vec3>& next_positions() { return next_positions_; }
   // The proposed velocities, for schemes that carry velocities; the others carry r⁻ instead,
@@ -123,6 +129,7 @@ class VerletFamily : public Scheme {
   VerletFamily(const StepContext& context, const Field<Vec3>& positions, Integrator scheme);
 
   std::optional<std::string> advance(long step) final;
+  void set_velocities(const std::vector<NodeVelocity>& velocities) override;
   // The backward difference (r − r⁻)/Δt: the velocity half a step back.
   const Field<Vec3>& velocities() override;
   std::vector<StateField> state_fields() override;

@@ -4,8 +4,10 @@
 
 #include <mpi.h>
 
+#include <memory>
 #include <optional>
 
+#include "cosserat/contact/contact.hpp"
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/halo.hpp"
@@ -17,6 +19,12 @@
 namespace cosserat {
 
 // Whole-sheet quantities reported in the run summary; all global reductions.
+// What contact did over the accepted steps so far (CONTACT.md §5), the same on every rank.
+struct ContactSummary {
+  double max_penetration = 0.0;  // m, deepest any node sat inside a solid after a step
+  long max_contacts = 0;         // most nodes moved by contact in one step
+};
+
 struct Diagnostics {
   double area_ratio = 0.0;      // S / S0
   double kinetic_energy = 0.0;        // ½ Σ m |v|², m = Dynamics::node_mass()
@@ -57,6 +65,10 @@ class Simulation {
   Diagnostics diagnostics();
   // What adaptive steps estimate the next step from; global maxima, reads the ghosts of r.
   StateMeasures state_measures();
+  // The scene's solids, or null when it has none.
+  const Contact* contact() const { return contact_.get(); }
+  ContactSummary contact_summary() const;
+
   // The stored energy of MODEL.md §2.5 at the current positions (J); a global sum that costs
   // about one force evaluation, so not part of diagnostics().
   double elastic_energy() { return dynamics_.elastic_energy(stepper_.positions()); }
@@ -70,7 +82,10 @@ class Simulation {
   Block block_;
   Halo halo_;
   Dynamics dynamics_;
+  std::unique_ptr<Contact> contact_;
   Stepper stepper_;
+  class ContactAction;
+  ContactAction* contact_action_ = nullptr;  // owned by stepper_
 };
 
 }  // namespace cosserat

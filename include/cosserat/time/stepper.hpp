@@ -35,6 +35,10 @@ struct ProposedStep {
   const Field<Vec3>& positions;  // at the step's start
   Field<Vec3>& next_positions;
   Field<Vec3>* next_velocities;  // null for schemes that carry r⁻ instead (see Scheme)
+  double time = 0.0;             // at the step's start
+  // Nodes whose velocity an action set (a contact response): the scheme carries these into
+  // its next step, whether it holds velocities or r⁻ (Scheme::set_velocities).
+  std::vector<NodeVelocity> velocities;
 };
 
 // Something done on every step whatever the scheme (a contact response, a step-size choice):
@@ -44,6 +48,12 @@ class StepAction {
  public:
   virtual ~StepAction() = default;
   virtual void apply(ProposedStep& proposed) = 0;
+  // The step apply() saw passed the check and is now the current state.
+  virtual void accepted() {}
+  // State the action carries from step to step (a free body's motion), as numbers: part of
+  // roll-back snapshots and checkpoints; restore() takes what state() gave.
+  virtual std::vector<double> state() const { return {}; }
+  virtual void restore(const std::vector<double>& /*values*/) {}
 };
 
 class Stepper {
@@ -71,6 +81,7 @@ class Stepper {
     double last_dt = 0.0;
     std::vector<Field<Vec3>> fields;
     std::vector<Constraints::NodeState> constraints;
+    std::vector<std::vector<double>> actions;  // each action's state()
   };
   Snapshot snapshot();
   void restore(const Snapshot& snapshot);
@@ -84,6 +95,9 @@ class Stepper {
   // bitwise.
   std::vector<StateField> state_fields() { return scheme_->state_fields(); }
   Constraints& constraints() { return constraints_; }
+  // Each action's state() in the order added, and back (checkpoints).
+  std::vector<std::vector<double>> action_states() const;
+  void restore_action_states(const std::vector<std::vector<double>>& states);
   // Continues from `step` after the state was overwritten; with a fixed step the time is
   // step x dt, adaptive steps give the time and the size of the step that ended there.
   void resume(long step);

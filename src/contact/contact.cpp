@@ -1,0 +1,515 @@
+#include "cosserat/contact/contact.hpp"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace cosserat {
+
+namespace {
+
+// Detection and response passes over the nodes and cells before a node still inside a solid
+// is left for the next step (CONTACT.md §2: a bounded number of repeats).
+constexpr int kMaxPasses = 4;
+
+// The spherical-linear interpolation from a to b at s in [0, 1], along the shorter arc.
+Quaternion slerp(Quaternion a, const Quaternion& b, double s) {
+  double c = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
+  if (c < 0.0) {
+    a = {-a.w, -a.x, -a.y, -a.z};
+    c = -c;
+  }
+  double wa = 1.0 - s, wb = s;
+  if (c < 1.0 - 1e-12) {
+    const double angle = std::acos(c);
+    const double sin_angle = std::sin(angle);
+    wa = std::sin((1.0 - s) * angle) / sin_angle;
+    wb = std::sin(s * angle) / sin_angle;
+  }
+  return normalized({wa * a.w + wb * b.w, wa * a.x + wb * b.x, wa * a.y + wb * b.y,
+                     wa * a.z + wb * b.z});
+}
+
+// The rotation vector of unit quaternion q (angle × axis, angle in [0, π]).
+Vec3 rotation_vector(Quaternion q) {
+  if (q.w < 0.0) q = {-q.w, -q.x, -q.y, -q.z};
+  const Vec3 axis{q.x, q.y, q.z};
+  const double s = norm(axis);
+  if (s == 0.0) return {};
+  return (2.0 * std::atan2(s, q.w) / s) * axis;
+}
+
+// A kinematic solid's state at time t: closed forms of the time, so that the path is the same
+// on every rank and after any restart, however the steps fell.
+SolidState kinematic_state(const SolidSpec& spec, double t) {
+  const KinematicPath& path = spec.path;
+  SolidState s;
+  if (!path.keyframes.empty()) {
+    const std::vector<Keyframe>& keys = path.keyframes;
+    if (t <= keys.front().time) {
+      s.pose = {keys.front().position, keys.front().orientation};
+      return s;
+    }
+    if (t >= keys.back().time) {
+      s.pose = {keys.back().position, keys.back().orientation};
+      return s;
+    }
+    std::size_t i = 0;
+    while (keys[i + 1].time <= t) ++i;
+    const Keyframe& a = keys[i];
+    const Keyframe& b = keys[i + 1];
+    const double span = b.time - a.time;
+    const double frac = (t - a.time) / span;
+    s.pose = {a.position + frac * (b.position - a.position),
+              slerp(a.orientation, b.orientation, frac)};
+    s.velocity = (b.position - a.position) / span;
+    s.angular_velocity = rotation_vector(b.orientation * conjugate(a.orientation)) / span;
+    return s;
+  }
+  const double moved = std::clamp(t - path.start_time, 0.0, path.end_time - path.start_time);
+  s.pose = {spec.pose.position + moved * path.velocity,
+            from_rotation_vector(moved * path.angular_velocity) * spec.pose.orientation};
+  if (path.start_time <= t && t < path.end_time) {
+    s.velocity = path.velocity;
+    s.angular_velocity = path.angular_velocity;
+  }
+  return s;
+}
+
+// R diag(I) Rᵀ x and its inverse: a free body's inertia in the world frame.
+Vec3 inertia_times(const Quaternion& q, const Vec3& moments, const Vec3& x) {
+  Vec3 local = rotate(conjugate(q), x);
+  local = {moments.x * local.x, moments.y * local.y, moments.z * local.z};
+  return rotate(q, local);
+}
+Vec3 inertia_solve(const Quaternion& q, const Vec3& moments, const Vec3& x) {
+  Vec3 local = rotate(conjugate(q), x);
+  local = {local.x / moments.x, local.y / moments.y, local.z / moments.z};
+  return rotate(q, local);
+}
+
+// CONTACT.md §3: the velocity a node leaves with, from its velocity v relative to a surface
+// moving at `surface`, with outward normal n: v_n' = −e v_n when approaching, Coulomb
+// friction |Δv_t| ≤ μ |Δv_n|, sticking when that suffices.
+Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double e, double mu) {
+  const Vec3 relative = v - surface;
+  const double vn = dot(relative, n);
+  if (vn >= 0.0) return v;
+  const Vec3 vt = relative - vn * n;
+  const double dvn = -(1.0 + e) * vn;
+  const double speed_t = norm(vt);
+  const double slip = mu * dvn;
+  const Vec3 vt_after = speed_t <= slip ? Vec3{} : (1.0 - slip / speed_t) * vt;
+  return surface + (-e * vn) * n + vt_after;
+}
+
+
+}  // namespace
+
+// One node's change by one solid in one phase of one pass: the impulse J = m (v' − v) and the
+// change m (r' × v' − r × v) of the node's angular momentum about the origin. `key` orders the
+// sums by (pass, phase, solid, node), the same on every decomposition.
+struct Contact::Exchange {
+  std::int64_t key;
+  double values[6];
+};
+
+// A cell triangle pressed into a solid: its barycentric weights at the deepest point, the move
+// δ n of that point and the change of its velocity (CONTACT.md §2, "Between nodes").
+struct Contact::CellPush {
+  bool active = false;
+  std::array<double, 3> weights{};
+  Vec3 move;
+  Vec3 velocity_change;
+};
+
+Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo,
+                 double node_mass, const Vec3& gravity, double spacing)
+    : block_(&block),
+      halo_(&halo),
+      node_mass_(node_mass),
+      gravity_(gravity),
+      spacing_(spacing),
+      velocity_(block),
+      touched_(block) {
+  for (const SolidSpec& spec : solids) {
+    Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false};
+    if (spec.motion == SolidMotion::free) {
+      s.inertia_per_mass = s.geometry.inertia_per_mass();
+      s.state = {spec.pose, spec.body.initial_velocity, spec.body.initial_angular_velocity};
+      s.pushing = dot(spec.body.force, spec.body.force) > 0.0;
+      any_free_ = true;
+    } else if (spec.motion == SolidMotion::kinematic) {
+      s.state = kinematic_state(spec, 0.0);
+    } else {
+      s.state.pose = spec.pose;
+    }
+    s.proposed = s.state;
+    s.proposed_pushing = s.pushing;
+    solids_.push_back(std::move(s));
+  }
+}
+
+Contact::~Contact() = default;
+
+// A free body's state at time + dt before the cloth's impulses: velocity Verlet under gravity,
+// the push and linear drag; the rotation to second order through the angular velocity at the
+// half step, from the angular momentum, which nothing changes between contacts.
+void Contact::propose_free(Solid& s, double dt) const {
+  const FreeBody& body = s.spec.body;
+  const double mass = body.mass;
+  const auto acceleration = [&](const Vec3& v) {
+    Vec3 a = gravity_ - (body.drag / mass) * v;
+    if (s.pushing) a += body.force / mass;
+    return a;
+  };
+  const SolidState& now = s.state;
+  const Vec3 v_half = now.velocity + (0.5 * dt) * acceleration(now.velocity);
+  SolidState next;
+  next.pose.position = now.pose.position + dt * v_half;
+  next.velocity = v_half + (0.5 * dt) * acceleration(v_half);
+  const Vec3 moments = mass * s.inertia_per_mass;
+  const Vec3 spin = inertia_times(now.pose.orientation, moments, now.angular_velocity);
+  const Quaternion q_half = normalized(
+      from_rotation_vector((0.5 * dt) * now.angular_velocity) * now.pose.orientation);
+  const Vec3 omega_half = inertia_solve(q_half, moments, spin);
+  next.pose.orientation =
+      normalized(from_rotation_vector(dt * omega_half) * now.pose.orientation);
+  next.angular_velocity = inertia_solve(next.pose.orientation, moments, spin);
+  s.proposed = next;
+  s.proposed_pushing = s.pushing;
+}
+
+// CONTACT.md §3 at a world point of solid s with world normal n, for cloth of mass
+// `point_mass` there moving at `velocity`. Against a free body the change is that of the
+// two-body impact along n, m_eff/m of the change against an immovable surface, with
+// 1/m_eff = 1/m + 1/M + (r × n)·I⁻¹(r × n): one node meeting a body conserves energy at e = 1.
+Vec3 Contact::velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
+                              const Vec3& velocity, double point_mass) const {
+  const SolidState& body = s.proposed;
+  const Vec3 arm = point - body.pose.position;
+  const Vec3 surface = body.velocity + cross(body.angular_velocity, arm);
+  Vec3 change = respond_velocity(velocity, surface, normal, s.spec.restitution, s.spec.friction) -
+                velocity;
+  if (s.spec.motion == SolidMotion::free) {
+    const double mass = s.spec.body.mass;
+    const Vec3 lever = cross(arm, normal);
+    const double rotational =
+        dot(lever, inertia_solve(body.pose.orientation, mass * s.inertia_per_mass, lever));
+    change = (1.0 / (1.0 + point_mass * (1.0 / mass + rotational))) * change;
+  }
+  return change;
+}
+
+void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
+                     const Vec3& v_before, const Vec3& r_after,
+                     std::vector<Exchange>& out) const {
+  if (solids_[solid].spec.motion != SolidMotion::free) return;
+  const Vec3 v_after = velocity_(k, l);
+  const Vec3 j = node_mass_ * (v_after - v_before);
+  const Vec3 dl = node_mass_ * (cross(r_after, v_after) - cross(r_before, v_before));
+  const Block& b = *block_;
+  const std::int64_t nodes = static_cast<std::int64_t>(b.m) * b.n;
+  const auto count = static_cast<std::int64_t>(solids_.size());
+  const std::int64_t key =
+      ((static_cast<std::int64_t>(pass) * 2 + phase) * count + static_cast<std::int64_t>(solid)) *
+          nodes +
+      static_cast<std::int64_t>(l) * b.m + k;
+  out.push_back({key, {j.x, j.y, j.z, dl.x, dl.y, dl.z}});
+}
+
+// CONTACT.md §2, nodes: the segment from the node at the start of the step to its proposed end,
+// each end in the solid's frame at its own time, against the solid inflated by `thickness`.
+// An end inside goes to the nearest point of the inflated surface; an end beyond a thin solid
+// the segment passed through goes back onto the tangent plane where the segment entered.
+// Solids in scene order, each seeing the node where the ones before it put it.
+void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
+                        std::vector<Exchange>& out) {
+  const Block& b = *block_;
+  std::vector<std::vector<Exchange>> rows(static_cast<std::size_t>(b.owned_l()));
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l) {
+    std::vector<Exchange>& row = rows[static_cast<std::size_t>(l - b.l0)];
+    for (int k = b.k0; k < b.k1; ++k)
+      for (std::size_t i = 0; i < solids_.size(); ++i) {
+        const Solid& s = solids_[i];
+        const SolidGeometry& g = s.geometry;
+        const double offset = s.spec.thickness;
+        const Vec3 end = s.proposed.pose.to_local(next(k, l));
+        const Closest at_end = g.closest(end);
+        Vec3 target, normal;
+        if (at_end.distance < offset) {
+          normal = at_end.normal;
+          target = end + (offset - at_end.distance) * normal;
+        } else {
+          // Both ends outside: only a segment passing near a bounded solid can cross it.
+          if (s.spec.shape.kind == ShapeKind::plane) continue;
+          const Vec3 start = s.state.pose.to_local(current(k, l));
+          const Vec3 path = end - start;
+          if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
+          if (g.closest(start).distance < offset) continue;  // leaving, not entering
+          const std::optional<double> t = g.first_contact(start, end, offset);
+          if (!t) continue;
+          const Vec3 entry = start + *t * path;
+          normal = g.closest(entry).normal;
+          target = end - dot(end - entry, normal) * normal;
+        }
+        Vec3& r = next(k, l);
+        const Vec3 r_before = r;
+        const Vec3 v_before = velocity_(k, l);
+        r = s.proposed.pose.to_world(target);
+        velocity_(k, l) =
+            v_before + velocity_change(s, r, s.proposed.pose.direction_to_world(normal),
+                                       v_before, node_mass_);
+        touched_(k, l) = 1;
+        record(i, pass, 0, k, l, r_before, v_before, r, row);
+      }
+  }
+  for (const auto& row : rows) out.insert(out.end(), row.begin(), row.end());
+}
+
+// CONTACT.md §2, between nodes: each triangle of a cell (diagonal from (k, l) to (k+1, l+1))
+// at its point deepest in the solid, moved out through its three nodes with weights
+// w_i = b_i / Σ b_j², so the point itself moves by δ n and its velocity by the response's
+// change. Triangles are found on the cells touching owned nodes, ghosts included, so each
+// node sums the pushes of its six triangles in one fixed order, whatever the decomposition.
+void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
+                        std::vector<Exchange>& out) {
+  const Block& b = *block_;
+  const Solid& s = solids_[solid];
+  const SolidGeometry& g = s.geometry;
+  const double offset = s.spec.thickness;
+  const double reach = g.bounding_radius() + offset;
+  halo_->exchange(next);
+  halo_->exchange(velocity_);
+  // Cells (kc, lc), kc in [k0 − 1, k1), lc in [l0 − 1, l1), those inside the grid.
+  const int width = b.owned_k() + 1;
+  const auto cell = [&](int kc, int lc) {
+    return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * 2;
+  };
+  cells_.assign(static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2, CellPush{});
+  const double s_mass = node_mass_;
+#pragma omp parallel for schedule(static)
+  for (int lc = std::max(b.l0 - 1, 0); lc < std::min(b.l1, b.n - 1); ++lc)
+    for (int kc = std::max(b.k0 - 1, 0); kc < std::min(b.k1, b.m - 1); ++kc)
+      for (int tri = 0; tri < 2; ++tri) {
+        const std::array<std::array<int, 2>, 3> nodes =
+            tri == 0 ? std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}}
+                     : std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc + 1, lc + 1}, {kc, lc + 1}}};
+        std::array<Vec3, 3> p;
+        double nearest = 1e300, longest = 0.0;
+        for (int v = 0; v < 3; ++v) {
+          p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
+          nearest = std::min(nearest, norm(p[v]));
+        }
+        for (int v = 0; v < 3; ++v) longest = std::max(longest, norm(p[(v + 1) % 3] - p[v]));
+        if (nearest - longest > reach) continue;
+        const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
+        if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
+        const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
+        const Closest c = g.closest(point);
+        if (c.distance >= offset) continue;
+        const double squares = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+        const Vec3 normal = s.proposed.pose.direction_to_world(c.normal);
+        Vec3 velocity;
+        for (int v = 0; v < 3; ++v) velocity += w[v] * velocity_(nodes[v][0], nodes[v][1]);
+        CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(tri)];
+        push.active = true;
+        push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
+        push.move = (offset - c.distance) * normal;
+        push.velocity_change = velocity_change(s, s.proposed.pose.to_world(point), normal,
+                                               velocity, s_mass / squares);
+      }
+  // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
+  struct Around {
+    int dk, dl, tri, corner;
+  };
+  static constexpr std::array<Around, 6> around{
+      {{0, 0, 0, 0}, {0, 0, 1, 0}, {-1, 0, 0, 1}, {-1, -1, 0, 2}, {-1, -1, 1, 1}, {0, -1, 1, 2}}};
+  std::vector<std::vector<Exchange>> rows(static_cast<std::size_t>(b.owned_l()));
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      Vec3 move, dv;
+      bool pushed = false;
+      for (const Around& a : around) {
+        const int kc = k + a.dk, lc = l + a.dl;
+        if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
+        const CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(a.tri)];
+        if (!push.active) continue;
+        const double weight = push.weights[static_cast<std::size_t>(a.corner)];
+        move += weight * push.move;
+        dv += weight * push.velocity_change;
+        pushed = true;
+      }
+      if (!pushed) continue;
+      Vec3& r = next(k, l);
+      const Vec3 r_before = r;
+      const Vec3 v_before = velocity_(k, l);
+      r += move;
+      velocity_(k, l) += dv;
+      touched_(k, l) = 1;
+      record(solid, pass, 1, k, l, r_before, v_before, r, rows[static_cast<std::size_t>(l - b.l0)]);
+    }
+  for (const auto& row : rows) out.insert(out.end(), row.begin(), row.end());
+}
+
+bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {
+  const Block& b = *block_;
+  int inside = 0;
+  double deepest = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : inside, deepest)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k)
+      for (const Solid& s : solids_) {
+        const Vec3 p = s.proposed.pose.to_local(next(k, l));
+        const double offset = s.spec.thickness;
+        if (norm(p) > s.geometry.bounding_radius() + offset) continue;
+        const double d = s.geometry.closest(p).distance;
+        deepest = std::max(deepest, -d);
+        // Round-off of the projection onto the offset surface is not inside.
+        if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
+      }
+  penetration = std::max(penetration, deepest);
+  int any = inside;
+  MPI_Allreduce(&inside, &any, 1, MPI_INT, MPI_MAX, block_->comm);
+  return any != 0;
+}
+
+ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current,
+                              Field<Vec3>& next, const Field<Vec3>* next_velocities,
+                              std::vector<NodeVelocity>& corrected) {
+  const Block& b = *block_;
+  for (Solid& s : solids_) {
+    if (s.spec.motion == SolidMotion::free)
+      propose_free(s, dt);
+    else if (s.spec.motion == SolidMotion::kinematic)
+      s.proposed = kinematic_state(s.spec, time + dt);
+  }
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      velocity_(k, l) =
+          next_velocities ? (*next_velocities)(k, l) : (next(k, l) - current(k, l)) / dt;
+      touched_(k, l) = 0;
+    }
+
+  std::vector<Exchange> exchanges;
+  ContactStats stats;
+  for (int pass = 0; pass < kMaxPasses; ++pass) {
+    node_pass(pass, current, next, exchanges);
+    for (std::size_t i = 0; i < solids_.size(); ++i)
+      if (std::isfinite(solids_[i].geometry.bounding_radius())) cell_pass(pass, i, next, exchanges);
+    double penetration = 0.0;
+    const bool inside = any_inside(next, penetration);
+    stats.max_penetration = penetration;
+    if (!inside) break;
+  }
+  double deepest = stats.max_penetration;
+  MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
+
+  long local = 0;
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k)
+      if (touched_(k, l)) {
+        corrected.push_back({k, l, velocity_(k, l)});
+        ++local;
+      }
+  MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
+  if (any_free_) apply_impulses(exchanges);
+  return stats;
+}
+
+// CONTACT.md §3–§4: each free body takes −ΣJ and the angular momentum the nodes gained about
+// its centre, summed in the order of the exchanges' keys after gathering every rank's, so the
+// sum is the same on every rank and for every decomposition. The body's angular momentum
+// takes −Σ m (r' × v' − r × v) + x × ΣJ: with the linear part, cloth and body together keep
+// their momentum and angular momentum about the origin exactly up to round-off, the nodes'
+// moves onto the surface included (where a node does not move this is −Σ (r − x) × J).
+void Contact::apply_impulses(std::vector<Exchange>& exchanges) {
+  const MPI_Comm comm = block_->comm;
+  int ranks = 1;
+  MPI_Comm_size(comm, &ranks);
+  const int bytes = static_cast<int>(exchanges.size() * sizeof(Exchange));
+  std::vector<int> counts(static_cast<std::size_t>(ranks)), displacements(counts.size());
+  MPI_Allgather(&bytes, 1, MPI_INT, counts.data(), 1, MPI_INT, comm);
+  int total = 0;
+  for (std::size_t r = 0; r < counts.size(); ++r) {
+    displacements[r] = total;
+    total += counts[r];
+  }
+  std::vector<Exchange> all(static_cast<std::size_t>(total) / sizeof(Exchange));
+  MPI_Allgatherv(exchanges.data(), bytes, MPI_BYTE, all.data(), counts.data(),
+                 displacements.data(), MPI_BYTE, comm);
+  std::sort(all.begin(), all.end(),
+            [](const Exchange& a, const Exchange& b) { return a.key < b.key; });
+  const auto nodes = static_cast<std::int64_t>(block_->m) * block_->n;
+  const auto count = static_cast<std::int64_t>(solids_.size());
+  std::vector<Vec3> impulse(solids_.size()), angular(solids_.size());
+  std::vector<char> touched(solids_.size(), 0);
+  for (const Exchange& e : all) {
+    const auto i = static_cast<std::size_t>((e.key / nodes) % count);
+    impulse[i] += Vec3{e.values[0], e.values[1], e.values[2]};
+    angular[i] += Vec3{e.values[3], e.values[4], e.values[5]};
+    touched[i] = 1;
+  }
+  for (std::size_t i = 0; i < solids_.size(); ++i) {
+    Solid& s = solids_[i];
+    if (s.spec.motion != SolidMotion::free || !touched[i]) continue;
+    const double mass = s.spec.body.mass;
+    SolidState& body = s.proposed;
+    const Vec3 moments = mass * s.inertia_per_mass;
+    Vec3 spin = inertia_times(body.pose.orientation, moments, body.angular_velocity);
+    spin += cross(body.pose.position, impulse[i]) - angular[i];
+    body.velocity -= impulse[i] / mass;
+    body.angular_velocity = inertia_solve(body.pose.orientation, moments, spin);
+    if (s.spec.body.force_until_contact) s.proposed_pushing = false;
+  }
+}
+
+void Contact::accept() {
+  for (Solid& s : solids_) {
+    s.state = s.proposed;
+    s.pushing = s.proposed_pushing;
+  }
+}
+
+namespace {
+constexpr std::size_t kStateSize = 14;  // position 3, orientation 4, velocity 3, ω 3, pushing
+}
+
+std::vector<double> Contact::state_vector() const {
+  std::vector<double> v;
+  for (const Solid& s : solids_) {
+    const SolidState& st = s.state;
+    const Quaternion& q = st.pose.orientation;
+    v.insert(v.end(), {st.pose.position.x, st.pose.position.y, st.pose.position.z, q.w, q.x, q.y,
+                       q.z, st.velocity.x, st.velocity.y, st.velocity.z, st.angular_velocity.x,
+                       st.angular_velocity.y, st.angular_velocity.z, s.pushing ? 1.0 : 0.0});
+  }
+  return v;
+}
+
+void Contact::restore(const std::vector<double>& v) {
+  if (v.size() != solids_.size() * kStateSize)
+    throw std::invalid_argument("contact state: " + std::to_string(v.size()) + " numbers for " +
+                                std::to_string(solids_.size()) + " solids");
+  for (std::size_t i = 0; i < solids_.size(); ++i) {
+    const double* x = v.data() + i * kStateSize;
+    Solid& s = solids_[i];
+    s.state.pose = {{x[0], x[1], x[2]}, {x[3], x[4], x[5], x[6]}};
+    s.state.velocity = {x[7], x[8], x[9]};
+    s.state.angular_velocity = {x[10], x[11], x[12]};
+    s.pushing = x[13] != 0.0;
+    s.proposed = s.state;
+    s.proposed_pushing = s.pushing;
+  }
+}
+
+}  // namespace cosserat

@@ -1,0 +1,261 @@
+// Cloth against rigid solids (CONTACT.md §2–§3): each test checks a law the response must
+// keep — no node inside a solid, Coulomb's law on an incline, restitution, momentum exchange
+// with a free body, symmetry, no tunnelling — on small sheets built in code.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "cosserat/baseline/semi_implicit.hpp"
+#include "support/sheets.hpp"
+
+namespace cosserat {
+namespace {
+
+SolidSpec plane(const Vec3& point, const Vec3& normal) {
+  SolidSpec s;
+  s.name = "plane";
+  s.shape.kind = ShapeKind::plane;
+  s.pose = {point, rotation_between({0.0, 0.0, 1.0}, normal / norm(normal))};
+  return s;
+}
+
+SolidSpec sphere(const Vec3& center, double radius) {
+  SolidSpec s;
+  s.name = "sphere";
+  s.shape.kind = ShapeKind::sphere;
+  s.shape.radius = radius;
+  s.pose.position = center;
+  return s;
+}
+
+// A sheet in the x–z plane at height y, `size` metres square, resting (no stiffness needed:
+// it moves as one piece in these tests unless a solid bends it).
+Scene sheet_at(int nodes, double size, double y) {
+  Scene s = testing::flat_sheet(nodes, nodes);
+  s.size1 = s.size2 = size;
+  s.origin = {-0.5 * size, y, -0.5 * size};
+  s.material.mass = 0.2 * size * size;  // 200 g/m²
+  return s;
+}
+
+double lowest_y(const Simulation& sim) {
+  const Block& b = sim.block();
+  double y = std::numeric_limits<double>::infinity();
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) y = std::min(y, sim.positions()(k, l).y);
+  return y;
+}
+
+Vec3 mean_position(const Simulation& sim) {
+  const Block& b = sim.block();
+  Vec3 sum;
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) sum += sim.positions()(k, l);
+  return sum / (static_cast<double>(b.m) * b.n);
+}
+
+// Coulomb (CONTACT.md §3): on a plane tilted by θ a sheet stays put when tan θ < μ and slides
+// with acceleration g (sin θ − μ cos θ) when tan θ > μ. The plane is y = 0; gravity is tilted
+// instead, so the sheet's slide is along x.
+double slide_acceleration(double theta, double mu, double* drift_when_stuck) {
+  const double g = 9.81;
+  Scene scene = sheet_at(6, 0.5, 0.0);
+  scene.gravity = {g * std::sin(theta), -g * std::cos(theta), 0.0};
+  SolidSpec floor = plane({0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
+  floor.friction = mu;
+  floor.thickness = 1e-3;
+  scene.origin.y = floor.thickness;
+  scene.solids.push_back(floor);
+  scene.dt = 1e-3;
+  Simulation sim(scene, MPI_COMM_SELF);
+  const double x0 = mean_position(sim).x;
+  const long steps = 500;
+  EXPECT_TRUE(testing::advance(sim, steps));
+  const double t = sim.time();
+  const double x = mean_position(sim).x - x0;
+  EXPECT_GT(lowest_y(sim), 0.0) << "the sheet sank into the incline";
+  if (drift_when_stuck) *drift_when_stuck = std::abs(x);
+  return 2.0 * x / (t * t);
+}
+
+TEST(Contact, CoulombFrictionHoldsBelowTheAngleOfReposeAndSlidesAbove) {
+  const double mu = 0.5;
+  double drift = 0.0;
+  slide_acceleration(std::atan(0.8 * mu), mu, &drift);
+  EXPECT_LT(drift, 1e-9) << "stuck: tan θ = 0.4 < μ = 0.5";
+  for (const double tan_theta : {0.7, 1.0, 2.0}) {
+    const double theta = std::atan(tan_theta);
+    const double expected = 9.81 * (std::sin(theta) - mu * std::cos(theta));
+    const double measured = slide_acceleration(theta, mu, nullptr);
+    EXPECT_NEAR(measured, expected, 0.02 * expected) << "tan θ = " << tan_theta;
+  }
+}
+
+// Restitution (CONTACT.md §3): a flat sheet without stiffness dropped from height H onto a
+// frictionless plane rebounds to H with e = 1 (to the step's accuracy) and stays down with
+// e = 0.
+double rebound_height(Integrator integrator, double restitution, double dt) {
+  const double drop = 0.5;
+  Scene scene = sheet_at(5, 0.4, drop);
+  scene.material.zeta = scene.material.xi = scene.material.phi = {0.0, 0.0, 0.0};
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.integrator = integrator;
+  scene.dt = dt;
+  SolidSpec floor = plane({0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
+  floor.restitution = restitution;
+  floor.friction = 0.0;
+  scene.solids.push_back(floor);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
+  // Falls for 0.32 s, rises for as long: the top of the rebound is before 0.7 s.
+  double highest_after_impact = 0.0;
+  bool hit = false;
+  const long steps = std::lround(0.8 / dt);
+  for (long i = 0; i < steps; ++i) {
+    EXPECT_FALSE(sim.step());
+    const double y = lowest_y(sim);
+    EXPECT_GE(y, -1e-12);
+    if (y < 0.05) hit = true;
+    if (hit) highest_after_impact = std::max(highest_after_impact, y);
+  }
+  EXPECT_TRUE(hit);
+  return highest_after_impact;
+}
+
+TEST(Contact, ElasticReboundReachesTheDropHeightAndInelasticStaysDown) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet, Integrator::rk4}) {
+    const double coarse = rebound_height(integrator, 1.0, 1e-3);
+    const double fine = rebound_height(integrator, 1.0, 2.5e-4);
+    EXPECT_NEAR(fine, 0.5, 0.005) << integrator_name(integrator);
+    // The error is the step's: it shrinks with the step.
+    EXPECT_LT(std::abs(fine - 0.5), std::abs(coarse - 0.5) + 1e-9) << integrator_name(integrator);
+    EXPECT_LT(rebound_height(integrator, 0.0, 1e-3), 1e-3) << integrator_name(integrator);
+  }
+}
+
+// Tunnelling (CONTACT.md §2): a sheet at 50 m/s meets a plane of zero thickness 2 cm below
+// it, 5 cm per step: continuous detection stops it at the plane.
+TEST(Contact, AFastSheetDoesNotPassThroughAThinPlane) {
+  Scene scene = sheet_at(6, 0.5, 0.02);
+  scene.initial_velocity = {0.0, -50.0, 0.0};
+  scene.dt = 1e-3;
+  SolidSpec floor = plane({0.0, 0.0, 0.0}, {0.0, 1.0, 0.0});
+  floor.thickness = 0.0;
+  scene.solids.push_back(floor);
+  Simulation sim(scene, MPI_COMM_SELF);
+  for (int i = 0; i < 20; ++i) {
+    ASSERT_FALSE(sim.step());
+    EXPECT_GE(lowest_y(sim), 0.0);
+  }
+  EXPECT_LE(sim.contact_summary().max_penetration, 0.0);
+}
+
+// A sphere far smaller than the grid spacing under the middle of a cell: no node ever touches
+// it, so only the cell test (CONTACT.md §2, between nodes) can carry the sheet.
+TEST(Contact, ASphereSmallerThanACellCarriesTheSheet) {
+  Scene scene = sheet_at(6, 1.0, 0.1);  // h = 0.2 m
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.dt = 1e-3;
+  SolidSpec ball = sphere({0.1, 0.0, 0.1}, 0.02);  // the centre of cell (2, 2)
+  ball.thickness = 1e-3;
+  scene.solids.push_back(ball);
+  SolidSpec floor = plane({0.0, -0.5, 0.0}, {0.0, 1.0, 0.0});
+  scene.solids.push_back(floor);
+  Simulation sim(scene, MPI_COMM_SELF);
+  ASSERT_TRUE(testing::advance(sim, 400));
+  // Without the cell test the middle of the sheet would be on the floor at y = −0.5.
+  const Block& b = sim.block();
+  const Vec3 a = sim.positions()(2, 2), c = sim.positions()(3, 3);
+  const Vec3 middle = 0.5 * (a + c);
+  EXPECT_GT(middle.y, 0.0) << "the sheet fell past the small sphere";
+  (void)b;
+}
+
+// Momentum (CONTACT.md §3): without gravity or held nodes, a free sphere hitting a free sheet
+// off-centre leaves the total linear and angular momentum of cloth and body unchanged to
+// round-off, and the kinetic energy never grows.
+TEST(Contact, AFreeBodyAndTheSheetExchangeMomentumExactly) {
+  Scene scene = sheet_at(9, 1.0, 0.0);
+  scene.material.zeta = {50.0, 0.0, 50.0};
+  scene.material.xi = {0.01, 0.0, 0.01};
+  scene.material.phi = {0.0, 0.0, 0.0};
+  scene.dt = 2e-4;
+  SolidSpec ball = sphere({0.13, 0.3, -0.07}, 0.2);
+  ball.motion = SolidMotion::free;
+  ball.body.mass = 2.0;
+  ball.body.initial_velocity = {0.3, -5.0, 0.2};
+  ball.body.initial_angular_velocity = {1.0, 2.0, -3.0};
+  ball.friction = 0.4;
+  ball.restitution = 0.0;
+  ball.thickness = 1e-3;
+  scene.solids.push_back(ball);
+  Simulation sim(scene, MPI_COMM_SELF);
+  const double m = scene.material.mass / (scene.m * scene.n);
+  const auto totals = [&](Vec3& p, Vec3& l, double& kinetic) {
+    const Block& b = sim.block();
+    p = l = {};
+    kinetic = 0.0;
+    const Field<Vec3>& r = sim.positions();
+    const Field<Vec3>& v = sim.velocities();
+    for (int j = b.l0; j < b.l1; ++j)
+      for (int k = b.k0; k < b.k1; ++k) {
+        p += m * v(k, j);
+        l += m * cross(r(k, j), v(k, j));
+        kinetic += 0.5 * m * dot(v(k, j), v(k, j));
+      }
+    const SolidState& s = sim.contact()->state(0);
+    const double mass = ball.body.mass;
+    const double moment = 0.4 * mass * ball.shape.radius * ball.shape.radius;
+    p += mass * s.velocity;
+    l += mass * cross(s.pose.position, s.velocity) + moment * s.angular_velocity;
+    kinetic += 0.5 * mass * dot(s.velocity, s.velocity) +
+               0.5 * moment * dot(s.angular_velocity, s.angular_velocity);
+  };
+  Vec3 p0, l0;
+  double k0 = 0.0;
+  totals(p0, l0, k0);
+  long contacts = 0;
+  for (int i = 0; i < 400; ++i) {
+    ASSERT_FALSE(sim.step());
+    Vec3 p, l;
+    double kinetic = 0.0;
+    totals(p, l, kinetic);
+    EXPECT_NEAR(norm(p - p0), 0.0, 1e-12 * norm(p0)) << "step " << i;
+    EXPECT_NEAR(norm(l - l0), 0.0, 1e-12 * norm(l0) + 1e-12) << "step " << i;
+    EXPECT_LE(kinetic, k0 * (1.0 + 1e-9)) << "step " << i;
+    contacts = std::max(contacts, sim.contact_summary().max_contacts);
+  }
+  EXPECT_GT(contacts, 0) << "the sphere never reached the sheet";
+}
+
+// Every scheme keeps every node out of a solid: a sheet falling onto a sphere under gravity.
+class EverySchemeOnASphere : public ::testing::TestWithParam<Integrator> {};
+
+TEST_P(EverySchemeOnASphere, NoNodeEndsAStepInsideTheSphere) {
+  Scene scene = sheet_at(11, 1.0, 0.35);
+  scene.integrator = GetParam();
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.dt = 5e-4;
+  SolidSpec ball = sphere({0.0, 0.0, 0.0}, 0.3);
+  ball.thickness = 2e-3;
+  scene.solids.push_back(ball);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
+  for (int i = 0; i < 600; ++i) {
+    ASSERT_FALSE(sim.step()) << "step " << i;
+    const Block& b = sim.block();
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k)
+        ASSERT_GE(norm(sim.positions()(k, l)), 0.3 - 1e-9) << k << ", " << l << " step " << i;
+  }
+  EXPECT_LT(sim.contact_summary().max_penetration, 1e-9);
+  EXPECT_GT(sim.contact_summary().max_contacts, 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Contact, EverySchemeOnASphere,
+                         ::testing::ValuesIn(testing::every_scheme()), testing::scheme_test_name);
+
+}  // namespace
+}  // namespace cosserat
