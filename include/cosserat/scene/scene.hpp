@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "cosserat/contact/solid.hpp"
 #include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/grid/vec3.hpp"
@@ -126,6 +127,8 @@ struct Scene {
 
   std::vector<Fix> fixes;
   std::vector<Load> loads;
+  // [[solid]]: rigid solids the cloth meets (CONTACT.md §1); empty means no contact code runs.
+  std::vector<SolidSpec> solids;
 
   // Warnings the loader found (e.g. a coupling that breaks positive definiteness).
   std::vector<std::string> warnings;
