@@ -164,6 +164,12 @@ void Table::allow(std::initializer_list<std::string_view> allowed) const {
   }
 }
 
+std::vector<std::string> Table::keys() const {
+  std::vector<std::string> names;
+  for (auto&& [name, node] : *table_) names.emplace_back(name.str());
+  return names;
+}
+
 std::optional<Entry> Table::find(std::string_view name) const {
   const auto* node = table_->get(name);
   if (node == nullptr) return std::nullopt;

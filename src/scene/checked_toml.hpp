@@ -87,6 +87,10 @@ class Table {
   // Rejects the first key not in `allowed`: a typo must not silently become a default.
   void allow(std::initializer_list<std::string_view> allowed) const;
 
+  // The keys given, in TOML's (sorted) order: for readers whose allowed keys depend on other
+  // keys, and which say why a known key does not belong.
+  std::vector<std::string> keys() const;
+
   std::optional<Entry> find(std::string_view name) const;
   std::optional<Table> find_table(std::string_view name) const;
 

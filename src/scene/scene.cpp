@@ -25,6 +25,7 @@
 #include "checked_toml.hpp"
 #include "cosserat/model/wave_speed.hpp"
 #include "overrides.hpp"
+#include "solids.hpp"
 
 namespace cosserat {
 namespace {
@@ -613,7 +614,8 @@ void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
 }
 
 void read_scene(const Table& root, const Origin& origin, Scene& scene) {
-  root.allow({"title", "grid", "material", "model", "environment", "time", "fix", "load"});
+  root.allow(
+      {"title", "grid", "material", "model", "environment", "time", "fix", "load", "solid"});
   if (const auto title = root.find("title")) scene.title = title->string();
   // Grid first: the material's mass and every node set depend on it.
   read_grid(root.require_table("grid", "a [grid] table with nodes and size"), scene);
@@ -632,6 +634,9 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   if (const auto loads = root.find("load")) {
     for (const auto& block : loads->tables("load")) scene.loads.push_back(read_load(block, scene));
   }
+  // Every integrator takes solids, the semi-implicit one too: contact acts on each accepted
+  // step, after the scheme, whatever the scheme.
+  if (const auto solids = root.find("solid")) scene.solids = read_solids(*solids, scene);
   warn_if_not_positive_definite(origin, scene);
 }
 

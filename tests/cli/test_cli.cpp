@@ -133,6 +133,17 @@ TEST_F(Cli, BadOverrideIsBadInput) {
   EXPECT_EQ(cosserat("run " + scene + " --set nokey -o " + path("o.h5")).status, 2);
 }
 
+TEST_F(Cli, BadSolidIsBadInputAndWritesNothing) {
+  const std::string scene = write_scene(
+      "solid.toml", std::string(kSmallScene) +
+                        "[[solid]]\nshape = \"sphere\"\ncenter = [5, -3, 5]\nradius = 1\n"
+                        "restitution = 1.5\n");
+  const Result r = cosserat("run " + scene + " --output " + path("out.h5"));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("solid[0].restitution"));
+  EXPECT_FALSE(fs::exists(path("out.h5")));
+}
+
 TEST_F(Cli, UnwritableOutputIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   const Result r = cosserat("run " + scene + " --output " + path("no/such/dir/out.h5"));
