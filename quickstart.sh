@@ -12,7 +12,7 @@ PACKAGES=(
   build-essential cmake ninja-build pkg-config git
   libopenmpi-dev openmpi-bin libhdf5-openmpi-dev hdf5-tools
   libtomlplusplus-dev libcli11-dev libfmt-dev libeigen3-dev
-  libgtest-dev libgmock-dev libbenchmark-dev libpetsc-real-dev
+  libgtest-dev libgmock-dev libbenchmark-dev libpetsc-real-dev libcgal-dev
   python3 python3-numpy python3-h5py python3-matplotlib
   clang-14 libclang-rt-14-dev
 )

@@ -1,0 +1,737 @@
+// The solids of CONTACT.md §1 in their own frames: closed forms for every shape but the mesh,
+// whose queries go through the CGAL tree of mesh_tree.cpp.
+
+#include "cosserat/contact/geometry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+#include <utility>
+
+#include "mesh_tree.hpp"
+
+namespace cosserat {
+
+Quaternion operator*(const Quaternion& a, const Quaternion& b) {
+  return {a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+          a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+          a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+          a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+}
+
+Quaternion conjugate(const Quaternion& q) { return {q.w, -q.x, -q.y, -q.z}; }
+
+Quaternion normalized(const Quaternion& q) {
+  const double length = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  if (!(length > 0.0) || !std::isfinite(length)) {
+    throw std::invalid_argument("normalized: a quaternion of zero or non-finite length has no orientation");
+  }
+  return {q.w / length, q.x / length, q.y / length, q.z / length};
+}
+
+Quaternion from_axis_angle(const Vec3& axis, double angle) {
+  const double length = norm(axis);
+  if (!(length > 0.0) || !std::isfinite(length)) {
+    throw std::invalid_argument("from_axis_angle: the axis must have a finite length > 0");
+  }
+  const Vec3 v = (std::sin(0.5 * angle) / length) * axis;
+  return {std::cos(0.5 * angle), v.x, v.y, v.z};
+}
+
+Quaternion from_rotation_vector(const Vec3& rotation) {
+  const double angle = norm(rotation);
+  if (angle == 0.0) return {};
+  return from_axis_angle(rotation, angle);
+}
+
+Quaternion rotation_between(const Vec3& a, const Vec3& b) {
+  const double c = dot(a, b);
+  // (1 + a·b, a × b) halves the angle without trigonometry, but vanishes for opposite vectors,
+  // where every axis normal to a is a shortest rotation: take the one normal to a and to the
+  // coordinate axis a is least aligned with, so the choice is deterministic.
+  if (1.0 + c > 1e-14) {
+    const Vec3 v = cross(a, b);
+    return normalized({1.0 + c, v.x, v.y, v.z});
+  }
+  const Vec3 e = std::abs(a.x) <= std::abs(a.y) && std::abs(a.x) <= std::abs(a.z)
+                     ? Vec3{1.0, 0.0, 0.0}
+                     : (std::abs(a.y) <= std::abs(a.z) ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0});
+  const Vec3 axis = cross(a, e);
+  return from_axis_angle(axis, std::numbers::pi);
+}
+
+Vec3 rotate(const Quaternion& q, const Vec3& v) {
+  const Vec3 u{q.x, q.y, q.z};
+  const Vec3 t = 2.0 * cross(u, v);
+  return v + q.w * t + cross(u, t);
+}
+
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// ---- Signed distances in the shape's frame ------------------------------------------------
+// Where the nearest surface point is not unique (a centre, an axis) the normal is a fixed
+// axis: any choice is a valid subgradient of the distance, and a fixed one keeps runs
+// repeatable.
+
+Closest plane_closest(const Vec3& p) { return {p.z, {0.0, 0.0, 1.0}}; }
+
+Closest sphere_closest(const Vec3& p, double radius) {
+  const double r = norm(p);
+  if (r == 0.0) return {-radius, {0.0, 0.0, 1.0}};
+  return {r - radius, p / r};
+}
+
+Closest box_closest(const Vec3& p, const Vec3& half) {
+  const Vec3 q{std::abs(p.x) - half.x, std::abs(p.y) - half.y, std::abs(p.z) - half.z};
+  const Vec3 outside{std::max(q.x, 0.0), std::max(q.y, 0.0), std::max(q.z, 0.0)};
+  const double gap = norm(outside);
+  if (gap > 0.0) {
+    return {gap, Vec3{std::copysign(outside.x, p.x), std::copysign(outside.y, p.y),
+                      std::copysign(outside.z, p.z)} / gap};
+  }
+  // Inside or on the surface: the nearest face, the first axis on a tie.
+  int axis = 0;
+  for (int i = 1; i < 3; ++i) {
+    if (q[i] > q[axis]) axis = i;
+  }
+  Vec3 normal;
+  normal[axis] = p[axis] < 0.0 ? -1.0 : 1.0;
+  return {q[axis], normal};
+}
+
+Closest cylinder_closest(const Vec3& p, double radius, double half_length) {
+  const double r = std::hypot(p.x, p.y);
+  const Vec3 radial = r > 0.0 ? Vec3{p.x / r, p.y / r, 0.0} : Vec3{1.0, 0.0, 0.0};
+  const Vec3 axial{0.0, 0.0, p.z < 0.0 ? -1.0 : 1.0};
+  const double side = r - radius;
+  const double cap = std::abs(p.z) - half_length;
+  if (side > 0.0 || cap > 0.0) {
+    const double s = std::max(side, 0.0);
+    const double c = std::max(cap, 0.0);
+    const double gap = std::hypot(s, c);
+    return {gap, (s / gap) * radial + (c / gap) * axial};
+  }
+  if (cap >= side) return {cap, axial};
+  return {side, radial};
+}
+
+Closest capsule_closest(const Vec3& p, double radius, double half_length) {
+  const Vec3 spine{0.0, 0.0, std::clamp(p.z, -half_length, half_length)};
+  const Vec3 d = p - spine;
+  const double r = norm(d);
+  if (r == 0.0) return {-radius, {1.0, 0.0, 0.0}};
+  return {r - radius, d / r};
+}
+
+// ---- Closest points between a triangle and simple features --------------------------------
+
+using Weights = std::array<double, 3>;
+
+Vec3 at(const Weights& w, const Vec3& a, const Vec3& b, const Vec3& c) {
+  return w[0] * a + w[1] * b + w[2] * c;
+}
+
+// The parameter in [0, 1] of the point of segment (a, b) nearest to p.
+double closest_on_segment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const double length2 = dot(ab, ab);
+  if (!(length2 > 0.0)) return 0.0;
+  return std::clamp(dot(p - a, ab) / length2, 0.0, 1.0);
+}
+
+// Parameters (s, t) of the nearest points of segments p0 + s (p1 - p0) and q0 + t (q1 - q0)
+// (Ericson, Real-Time Collision Detection, §5.1.9), degenerate segments included.
+std::pair<double, double> closest_segment_segment(const Vec3& p0, const Vec3& p1, const Vec3& q0,
+                                                  const Vec3& q1) {
+  const Vec3 d1 = p1 - p0;
+  const Vec3 d2 = q1 - q0;
+  const Vec3 r = p0 - q0;
+  const double a = dot(d1, d1);
+  const double e = dot(d2, d2);
+  const double f = dot(d2, r);
+  if (a <= 0.0 && e <= 0.0) return {0.0, 0.0};
+  if (a <= 0.0) return {0.0, std::clamp(f / e, 0.0, 1.0)};
+  const double c = dot(d1, r);
+  if (e <= 0.0) return {std::clamp(-c / a, 0.0, 1.0), 0.0};
+  const double b = dot(d1, d2);
+  const double denominator = a * e - b * b;
+  double s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  double t = (b * s + f) / e;
+  if (t < 0.0) {
+    t = 0.0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  } else if (t > 1.0) {
+    t = 1.0;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  return {s, t};
+}
+
+// Barycentric weights of the point of triangle (a, b, c) nearest to p, by Voronoi region
+// (Ericson §5.1.5), so exact on vertices and edges; a degenerate triangle falls back to its
+// edges.
+Weights closest_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  const Vec3 ap = p - a;
+  const double d1 = dot(ab, ap);
+  const double d2 = dot(ac, ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return {1.0, 0.0, 0.0};
+  const Vec3 bp = p - b;
+  const double d3 = dot(ab, bp);
+  const double d4 = dot(ac, bp);
+  if (d3 >= 0.0 && d4 <= d3) return {0.0, 1.0, 0.0};
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 && d1 - d3 > 0.0) {
+    const double v = d1 / (d1 - d3);
+    return {1.0 - v, v, 0.0};
+  }
+  const Vec3 cp = p - c;
+  const double d5 = dot(ab, cp);
+  const double d6 = dot(ac, cp);
+  if (d6 >= 0.0 && d5 <= d6) return {0.0, 0.0, 1.0};
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 && d2 - d6 > 0.0) {
+    const double w = d2 / (d2 - d6);
+    return {1.0 - w, 0.0, w};
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 && (d4 - d3) + (d5 - d6) > 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return {0.0, 1.0 - w, w};
+  }
+  const double area = va + vb + vc;
+  if (area > 0.0) {
+    const double v = vb / area;
+    const double w = vc / area;
+    return {1.0 - v - w, v, w};
+  }
+  const std::array<Weights, 3> on_edges{
+      Weights{1.0 - closest_on_segment(p, a, b), closest_on_segment(p, a, b), 0.0},
+      Weights{0.0, 1.0 - closest_on_segment(p, b, c), closest_on_segment(p, b, c)},
+      Weights{closest_on_segment(p, c, a), 0.0, 1.0 - closest_on_segment(p, c, a)}};
+  Weights best = on_edges[0];
+  double best_distance2 = kInfinity;
+  for (const Weights& w : on_edges) {
+    const Vec3 d = at(w, a, b, c) - p;
+    if (dot(d, d) < best_distance2) {
+      best_distance2 = dot(d, d);
+      best = w;
+    }
+  }
+  return best;
+}
+
+// The point of triangle (a, b, c) nearest to segment (p0, p1), as weights on the triangle: the
+// crossing if the segment pierces it, else the best of the segment's ends against the triangle
+// and the segment against the triangle's edges.
+Weights closest_segment_triangle(const Vec3& p0, const Vec3& p1, const Vec3& a, const Vec3& b,
+                                 const Vec3& c) {
+  Weights best{1.0, 0.0, 0.0};
+  double best_distance2 = kInfinity;
+  const auto consider = [&](const Weights& w, const Vec3& on_segment) {
+    const Vec3 d = at(w, a, b, c) - on_segment;
+    if (dot(d, d) < best_distance2) {
+      best_distance2 = dot(d, d);
+      best = w;
+    }
+  };
+  const Vec3 n = cross(b - a, c - a);
+  const double h0 = dot(n, p0 - a);
+  const double h1 = dot(n, p1 - a);
+  if (((h0 <= 0.0 && h1 >= 0.0) || (h0 >= 0.0 && h1 <= 0.0)) && h0 != h1) {
+    const Vec3 crossing = p0 + (h0 / (h0 - h1)) * (p1 - p0);
+    consider(closest_on_triangle(crossing, a, b, c), crossing);
+  }
+  consider(closest_on_triangle(p0, a, b, c), p0);
+  consider(closest_on_triangle(p1, a, b, c), p1);
+  const std::array<std::pair<int, int>, 3> edges{{{0, 1}, {1, 2}, {2, 0}}};
+  const std::array<Vec3, 3> corner{a, b, c};
+  for (const auto& [i, j] : edges) {
+    const auto [s, t] = closest_segment_segment(p0, p1, corner[i], corner[j]);
+    Weights w{0.0, 0.0, 0.0};
+    w[i] = 1.0 - t;
+    w[j] = t;
+    consider(w, p0 + s * (p1 - p0));
+  }
+  return best;
+}
+
+// Weights made exactly non-negative and summing to one (round-off of the constructions).
+Weights clean(Weights w) {
+  for (double& x : w) x = std::max(x, 0.0);
+  const double sum = w[0] + w[1] + w[2];
+  if (!(sum > 0.0)) return {1.0, 0.0, 0.0};
+  return {w[0] / sum, w[1] / sum, w[2] / sum};
+}
+
+// ---- Surfaces for output -----------------------------------------------------------------
+
+// A closed surface of revolution about z from a profile of (radius, z) running from the top
+// pole to the bottom pole (radius 0 at both, > 0 between): fans at the poles, quads between
+// rings, counter-clockwise seen from outside.
+TriangleMesh revolution_surface(const std::vector<std::pair<double, double>>& profile,
+                                int segments) {
+  TriangleMesh mesh;
+  const int rings = static_cast<int>(profile.size()) - 2;
+  mesh.vertices.push_back({0.0, 0.0, profile.front().second});
+  for (int k = 1; k <= rings; ++k) {
+    const auto [r, z] = profile[k];
+    for (int j = 0; j < segments; ++j) {
+      const double phi = 2.0 * std::numbers::pi * j / segments;
+      mesh.vertices.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    }
+  }
+  const int bottom = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.push_back({0.0, 0.0, profile.back().second});
+  const auto ring = [segments](int k, int j) { return 1 + (k - 1) * segments + j % segments; };
+  for (int j = 0; j < segments; ++j) {
+    mesh.triangles.push_back({0, ring(1, j), ring(1, j + 1)});
+    for (int k = 1; k < rings; ++k) {
+      mesh.triangles.push_back({ring(k, j), ring(k + 1, j), ring(k + 1, j + 1)});
+      mesh.triangles.push_back({ring(k, j), ring(k + 1, j + 1), ring(k, j + 1)});
+    }
+    mesh.triangles.push_back({bottom, ring(rings, j + 1), ring(rings, j)});
+  }
+  return mesh;
+}
+
+// The icosahedron subdivided twice (320 triangles): even triangles, unlike a UV sphere's
+// slivers at the poles.
+TriangleMesh icosphere(double radius) {
+  const double g = std::numbers::phi;
+  TriangleMesh mesh;
+  mesh.vertices = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                   {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  mesh.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                    {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                    {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                    {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (Vec3& v : mesh.vertices) v = v / norm(v);
+  for (int level = 0; level < 2; ++level) {
+    std::map<std::pair<int, int>, int> midpoints;
+    const auto midpoint = [&](int i, int j) {
+      const auto key = std::minmax(i, j);
+      const auto [it, inserted] = midpoints.try_emplace(key, static_cast<int>(mesh.vertices.size()));
+      if (inserted) {
+        const Vec3 m = mesh.vertices[i] + mesh.vertices[j];
+        mesh.vertices.push_back(m / norm(m));
+      }
+      return it->second;
+    };
+    std::vector<std::array<int, 3>> finer;
+    for (const auto& [a, b, c] : mesh.triangles) {
+      const int ab = midpoint(a, b);
+      const int bc = midpoint(b, c);
+      const int ca = midpoint(c, a);
+      finer.insert(finer.end(), {{a, ab, ca}, {b, bc, ab}, {c, ca, bc}, {ab, bc, ca}});
+    }
+    mesh.triangles = std::move(finer);
+  }
+  for (Vec3& v : mesh.vertices) v *= radius;
+  return mesh;
+}
+
+TriangleMesh box_surface(const Vec3& half) {
+  TriangleMesh mesh;
+  for (int i = 0; i < 8; ++i) {
+    mesh.vertices.push_back({(i & 1) ? half.x : -half.x, (i & 2) ? half.y : -half.y,
+                             (i & 4) ? half.z : -half.z});
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    const int j = (axis + 1) % 3;
+    const int k = (axis + 2) % 3;
+    for (const int side : {0, 1}) {
+      // The cycle (−,−), (+,−), (+,+), (−,+) in (e_j, e_k) turns about e_j × e_k = e_axis.
+      std::array<int, 4> cycle{};
+      const std::array<std::pair<int, int>, 4> signs{{{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
+      for (int n = 0; n < 4; ++n) {
+        cycle[n] = (side << axis) | (signs[n].first << j) | (signs[n].second << k);
+      }
+      if (side == 0) std::swap(cycle[1], cycle[3]);
+      mesh.triangles.push_back({cycle[0], cycle[1], cycle[2]});
+      mesh.triangles.push_back({cycle[0], cycle[2], cycle[3]});
+    }
+  }
+  return mesh;
+}
+
+constexpr int kRoundSegments = 32;
+
+// ---- deepest_point for each shape --------------------------------------------------------
+
+// Compass search on the weights from `start`: moves weight between two corners by a step
+// halved whenever no move lowers the distance. It uses values only (the distance inside a
+// box or a cylinder has kinks where gradients jump) and never raises the distance; on a kink
+// not aligned with any of its six directions it can stop short of the minimum.
+template <typename Distance>
+Weights compass_refine(Weights w, double value, const Distance& distance) {
+  constexpr double kSmallestStep = 1.0 / (1 << 16);
+  double step = 0.25;
+  while (step >= kSmallestStep) {
+    bool moved = false;
+    for (int from = 0; from < 3 && !moved; ++from) {
+      for (int to = 0; to < 3 && !moved; ++to) {
+        if (from == to || w[from] <= 0.0) continue;
+        Weights trial = w;
+        const double amount = std::min(step, w[from]);
+        trial[from] -= amount;
+        trial[to] += amount;
+        const double trial_value = distance(trial);
+        if (trial_value < value) {
+          w = trial;
+          value = trial_value;
+          moved = true;
+        }
+      }
+    }
+    if (!moved) step *= 0.5;
+  }
+  return w;
+}
+
+// The box's distance is exact from two candidate sets. Apart from the box, the nearest pair of
+// features of two convex polytopes is a vertex of one against the other or an edge against an
+// edge: the triangle's vertices, the box's corners against the triangle, the box's edges
+// against the triangle. Pressed into the box, the distance there is the largest of the six
+// face functions ±x_i − h_i, linear on the triangle, so its minimum is a vertex of that
+// piecewise-linear program: where two faces tie on a triangle edge, or three inside it.
+Weights box_deepest(const Vec3& half, const Vec3& a, const Vec3& b, const Vec3& c) {
+  std::vector<Weights> candidates{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  std::array<Vec3, 8> corners;
+  for (int i = 0; i < 8; ++i) {
+    corners[i] = {(i & 1) ? half.x : -half.x, (i & 2) ? half.y : -half.y,
+                  (i & 4) ? half.z : -half.z};
+    candidates.push_back(closest_on_triangle(corners[i], a, b, c));
+  }
+  for (int i = 0; i < 8; ++i) {
+    for (int bit = 1; bit < 8; bit <<= 1) {
+      if (!(i & bit)) candidates.push_back(closest_segment_triangle(corners[i], corners[i | bit], a, b, c));
+    }
+  }
+  // Face k: s x_axis − h_axis = alpha + beta u + gamma v at a + u (b − a) + v (c − a).
+  std::array<std::array<double, 3>, 6> face{};
+  for (int k = 0; k < 6; ++k) {
+    const int axis = k / 2;
+    const double s = (k % 2 == 0) ? 1.0 : -1.0;
+    face[k] = {s * a[axis] - half[axis], s * (b[axis] - a[axis]), s * (c[axis] - a[axis])};
+  }
+  const std::array<std::array<double, 2>, 3> ends{{{0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}}};
+  for (int k = 0; k < 6; ++k) {
+    for (int l = k + 1; l < 6; ++l) {
+      const std::array<double, 3> g{face[k][0] - face[l][0], face[k][1] - face[l][1],
+                                    face[k][2] - face[l][2]};
+      for (int e = 0; e < 3; ++e) {
+        const auto& p = ends[e];
+        const auto& q = ends[(e + 1) % 3];
+        const double g0 = g[0] + g[1] * p[0] + g[2] * p[1];
+        const double g1 = g[1] * (q[0] - p[0]) + g[2] * (q[1] - p[1]);
+        if (g1 == 0.0) continue;
+        const double sigma = -g0 / g1;
+        if (sigma < 0.0 || sigma > 1.0) continue;
+        const double u = p[0] + sigma * (q[0] - p[0]);
+        const double v = p[1] + sigma * (q[1] - p[1]);
+        candidates.push_back(clean({1.0 - u - v, u, v}));
+      }
+      for (int m = l + 1; m < 6; ++m) {
+        const double a11 = face[k][1] - face[l][1];
+        const double a12 = face[k][2] - face[l][2];
+        const double a21 = face[k][1] - face[m][1];
+        const double a22 = face[k][2] - face[m][2];
+        const double det = a11 * a22 - a12 * a21;
+        if (det == 0.0) continue;
+        const double r1 = face[l][0] - face[k][0];
+        const double r2 = face[m][0] - face[k][0];
+        const double u = (r1 * a22 - a12 * r2) / det;
+        const double v = (a11 * r2 - r1 * a21) / det;
+        if (u < 0.0 || v < 0.0 || u + v > 1.0) continue;
+        candidates.push_back(clean({1.0 - u - v, u, v}));
+      }
+    }
+  }
+  Weights best = candidates.front();
+  double best_value = kInfinity;
+  for (const Weights& w : candidates) {
+    const double value = box_closest(at(w, a, b, c), half).distance;
+    if (value < best_value) {
+      best_value = value;
+      best = w;
+    }
+  }
+  return clean(best);
+}
+
+// The cylinder's distance has a curved kink where side and cap meet, so no finite candidate
+// set is exact. These are exact where a side presses into the triangle (the triangle's point
+// nearest the axis) or a cap presses flat (the axis crossing it); rim samples cover a rim
+// pressing in, and compass search refines the best of them.
+Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const Vec3& b,
+                         const Vec3& c) {
+  std::vector<Weights> candidates{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+  candidates.push_back(closest_on_triangle({0.0, 0.0, 0.0}, a, b, c));
+  candidates.push_back(
+      closest_segment_triangle({0.0, 0.0, -half_length}, {0.0, 0.0, half_length}, a, b, c));
+  constexpr int kRimSamples = 16;
+  for (int j = 0; j < kRimSamples; ++j) {
+    const double phi = 2.0 * std::numbers::pi * j / kRimSamples;
+    for (const double z : {-half_length, half_length}) {
+      candidates.push_back(
+          closest_on_triangle({radius * std::cos(phi), radius * std::sin(phi), z}, a, b, c));
+    }
+  }
+  const auto distance = [&](const Weights& w) {
+    return cylinder_closest(at(w, a, b, c), radius, half_length).distance;
+  };
+  Weights best = candidates.front();
+  double best_value = kInfinity;
+  for (const Weights& w : candidates) {
+    const double value = distance(clean(w));
+    if (value < best_value) {
+      best_value = value;
+      best = clean(w);
+    }
+  }
+  return clean(compass_refine(best, best_value, distance));
+}
+
+}  // namespace
+
+SolidGeometry::SolidGeometry(Shape shape) : shape_(std::move(shape)) {
+  const auto positive = [](double x) { return x > 0.0 && std::isfinite(x); };
+  const auto fail = [](const char* what) { throw std::invalid_argument(what); };
+  switch (shape_.kind) {
+    case ShapeKind::plane:
+      break;
+    case ShapeKind::sphere:
+      if (!positive(shape_.radius)) fail("sphere: radius must be finite and > 0");
+      break;
+    case ShapeKind::box:
+      if (!positive(shape_.half_extents.x) || !positive(shape_.half_extents.y) ||
+          !positive(shape_.half_extents.z)) {
+        fail("box: half extents must be finite and > 0");
+      }
+      break;
+    case ShapeKind::cylinder:
+    case ShapeKind::capsule:
+      if (!positive(shape_.radius)) fail("cylinder or capsule: radius must be finite and > 0");
+      if (!(shape_.half_length >= 0.0) || !std::isfinite(shape_.half_length)) {
+        fail("cylinder or capsule: half_length must be finite and >= 0");
+      }
+      if (shape_.kind == ShapeKind::cylinder && shape_.half_length == 0.0) {
+        fail("cylinder: half_length must be > 0");
+      }
+      break;
+    case ShapeKind::mesh:
+      if (!shape_.mesh || shape_.mesh->triangles.empty()) fail("mesh: no triangles");
+      tree_ = std::make_unique<MeshTree>(*shape_.mesh);
+      break;
+  }
+}
+
+SolidGeometry::~SolidGeometry() = default;
+SolidGeometry::SolidGeometry(SolidGeometry&&) noexcept = default;
+SolidGeometry& SolidGeometry::operator=(SolidGeometry&&) noexcept = default;
+
+Closest SolidGeometry::closest(const Vec3& p) const {
+  switch (shape_.kind) {
+    case ShapeKind::plane:
+      return plane_closest(p);
+    case ShapeKind::sphere:
+      return sphere_closest(p, shape_.radius);
+    case ShapeKind::box:
+      return box_closest(p, shape_.half_extents);
+    case ShapeKind::cylinder:
+      return cylinder_closest(p, shape_.radius, shape_.half_length);
+    case ShapeKind::capsule:
+      return capsule_closest(p, shape_.radius, shape_.half_length);
+    case ShapeKind::mesh:
+      return tree_->closest(p);
+  }
+  throw std::logic_error("SolidGeometry::closest: unknown shape kind");
+}
+
+// Advancement on the signed distance, which never steps past the surface: every point within
+// the current gap of p lies outside the inflated solid. For the convex shapes the gap along a
+// line is convex, so the Newton step gap / (−gap′) (gap′ from the normal, a subgradient) still
+// never overshoots, converges quadratically instead of linearly on slanted approaches, and a
+// gap that stops falling can never fall again. A mesh is not convex: it advances by
+// gap / |b − a|, the step the 1-Lipschitz bound allows.
+std::optional<double> SolidGeometry::first_contact(const Vec3& a, const Vec3& b,
+                                                   double offset) const {
+  constexpr int kMaxIterations = 200;
+  // Contact within a relative 1e-7 of the step's scales: far below any response's own error,
+  // and reached in a few Newton steps.
+  const Vec3 d = b - a;
+  const double length = norm(d);
+  const double tolerance = 1e-7 * std::max(length, offset);
+  Closest nearest = closest(a);
+  double gap = nearest.distance - offset;
+  if (gap <= tolerance) return 0.0;
+  if (length == 0.0) return std::nullopt;
+  const bool convex = shape_.kind != ShapeKind::mesh;
+  double t = 0.0;
+  for (int iteration = 0; iteration < kMaxIterations; ++iteration) {
+    double rate = length;
+    if (convex) {
+      rate = -dot(nearest.normal, d);
+      if (rate <= 0.0) return std::nullopt;
+    }
+    t += gap / rate;
+    if (t > 1.0) return std::nullopt;
+    nearest = closest(a + t * d);
+    gap = nearest.distance - offset;
+    if (gap <= tolerance) return t;
+  }
+  // Only a mesh grazed at a shallow angle gets here: the segment is within its last gap of the
+  // surface, and a contact reported slightly early is safer than a tunnel.
+  return t;
+}
+
+std::array<double, 3> SolidGeometry::deepest_point(const Vec3& a, const Vec3& b,
+                                                   const Vec3& c) const {
+  switch (shape_.kind) {
+    case ShapeKind::plane: {
+      const std::array<double, 3> height{a.z, b.z, c.z};
+      const auto lowest = std::min_element(height.begin(), height.end()) - height.begin();
+      Weights w{0.0, 0.0, 0.0};
+      w[lowest] = 1.0;
+      return w;
+    }
+    case ShapeKind::sphere:
+      // The distance grows with the distance to the centre.
+      return clean(closest_on_triangle({0.0, 0.0, 0.0}, a, b, c));
+    case ShapeKind::capsule:
+      return clean(closest_segment_triangle({0.0, 0.0, -shape_.half_length},
+                                            {0.0, 0.0, shape_.half_length}, a, b, c));
+    case ShapeKind::box:
+      return box_deepest(shape_.half_extents, a, b, c);
+    case ShapeKind::cylinder:
+      return cylinder_deepest(shape_.radius, shape_.half_length, a, b, c);
+    case ShapeKind::mesh: {
+      // Sampled, not exact: a mesh's distance is not convex, so any local search could settle
+      // in the wrong valley; a fixed lattice of quarters (the vertices and edge midpoints among
+      // them) and the centroid find a mesh feature about a quarter of the triangle across.
+      constexpr int kDivisions = 4;
+      std::vector<Weights> samples{{1.0 / 3, 1.0 / 3, 1.0 / 3}};
+      for (int i = 0; i <= kDivisions; ++i) {
+        for (int j = 0; i + j <= kDivisions; ++j) {
+          samples.push_back({static_cast<double>(kDivisions - i - j) / kDivisions,
+                             static_cast<double>(i) / kDivisions,
+                             static_cast<double>(j) / kDivisions});
+        }
+      }
+      Weights best = samples.front();
+      double best_value = kInfinity;
+      for (const Weights& w : samples) {
+        const double value = tree_->closest(at(w, a, b, c)).distance;
+        if (value < best_value) {
+          best_value = value;
+          best = w;
+        }
+      }
+      return best;
+    }
+  }
+  throw std::logic_error("SolidGeometry::deepest_point: unknown shape kind");
+}
+
+double SolidGeometry::bounding_radius() const {
+  switch (shape_.kind) {
+    case ShapeKind::plane:
+      return kInfinity;
+    case ShapeKind::sphere:
+      return shape_.radius;
+    case ShapeKind::box:
+      return norm(shape_.half_extents);
+    case ShapeKind::cylinder:
+      return std::hypot(shape_.radius, shape_.half_length);
+    case ShapeKind::capsule:
+      return shape_.half_length + shape_.radius;
+    case ShapeKind::mesh: {
+      double radius = 0.0;
+      for (const Vec3& v : shape_.mesh->vertices) radius = std::max(radius, norm(v));
+      return radius;
+    }
+  }
+  throw std::logic_error("SolidGeometry::bounding_radius: unknown shape kind");
+}
+
+Vec3 SolidGeometry::inertia_per_mass() const {
+  const double r2 = shape_.radius * shape_.radius;
+  const double h = shape_.half_length;
+  switch (shape_.kind) {
+    case ShapeKind::sphere:
+      return {0.4 * r2, 0.4 * r2, 0.4 * r2};
+    case ShapeKind::box: {
+      const Vec3& e = shape_.half_extents;
+      return {(e.y * e.y + e.z * e.z) / 3.0, (e.x * e.x + e.z * e.z) / 3.0,
+              (e.x * e.x + e.y * e.y) / 3.0};
+    }
+    case ShapeKind::cylinder:
+      // Length 2h: r²/4 + (2h)²/12 across the axis.
+      return {0.25 * r2 + h * h / 3.0, 0.25 * r2 + h * h / 3.0, 0.5 * r2};
+    case ShapeKind::capsule: {
+      // Mass fractions of the cylinder (π r² 2h) and the two hemispheres (4/3 π r³). A
+      // hemisphere about its flat face's centre has the full sphere's 2/5 r² per mass; its
+      // centre of mass sits 3r/8 from that face, so shifting to its centre of mass and then to
+      // the capsule's centre, h + 3r/8 away, gives 2/5 r² + h² + 3/4 h r across the axis.
+      const double r = shape_.radius;
+      const double cylinder = 2.0 * h;
+      const double spheres = 4.0 / 3.0 * r;
+      const double total = cylinder + spheres;
+      const double across = (cylinder * (0.25 * r2 + h * h / 3.0) +
+                             spheres * (0.4 * r2 + h * h + 0.75 * h * r)) / total;
+      const double along = (cylinder * 0.5 * r2 + spheres * 0.4 * r2) / total;
+      return {across, across, along};
+    }
+    case ShapeKind::plane:
+    case ShapeKind::mesh:
+      break;
+  }
+  throw std::logic_error("inertia_per_mass: a plane or mesh solid has no closed-form mass properties");
+}
+
+TriangleMesh SolidGeometry::surface(double plane_extent) const {
+  switch (shape_.kind) {
+    case ShapeKind::plane: {
+      const double s = 0.5 * plane_extent;
+      return {{{-s, -s, 0.0}, {s, -s, 0.0}, {s, s, 0.0}, {-s, s, 0.0}}, {{0, 1, 2}, {0, 2, 3}}};
+    }
+    case ShapeKind::sphere:
+      return icosphere(shape_.radius);
+    case ShapeKind::box:
+      return box_surface(shape_.half_extents);
+    case ShapeKind::cylinder: {
+      const double r = shape_.radius;
+      const double h = shape_.half_length;
+      return revolution_surface({{0.0, h}, {r, h}, {r, -h}, {0.0, -h}}, kRoundSegments);
+    }
+    case ShapeKind::capsule: {
+      const double r = shape_.radius;
+      const double h = shape_.half_length;
+      constexpr int kBandsPerCap = 4;
+      std::vector<std::pair<double, double>> profile{{0.0, h + r}};
+      for (int k = 1; k <= kBandsPerCap; ++k) {
+        const double theta = 0.5 * std::numbers::pi * k / kBandsPerCap;
+        profile.emplace_back(r * std::sin(theta), h + r * std::cos(theta));
+      }
+      // Without a cylinder between them the hemispheres share their equator.
+      for (int k = h > 0.0 ? kBandsPerCap : kBandsPerCap - 1; k >= 1; --k) {
+        const double theta = 0.5 * std::numbers::pi * k / kBandsPerCap;
+        profile.emplace_back(r * std::sin(theta), -h - r * std::cos(theta));
+      }
+      profile.emplace_back(0.0, -h - r);
+      return revolution_surface(profile, kRoundSegments);
+    }
+    case ShapeKind::mesh:
+      return *shape_.mesh;
+  }
+  throw std::logic_error("SolidGeometry::surface: unknown shape kind");
+}
+
+}  // namespace cosserat
