@@ -207,6 +207,13 @@ Vec3 Contact::velocity_change(const Solid& s, const Vec3& point, const Vec3& nor
   return change;
 }
 
+// The step moved the node with its velocity before the response: friction's change of the
+// tangential velocity moves it too, Δt Δv_t, or a node that sticks would still creep by the
+// tangential a Δt² of every step.
+Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal) const {
+  return dt_ * (change - dot(change, normal) * normal);
+}
+
 void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
                      const Vec3& v_before, const Vec3& r_after,
                      std::vector<Exchange>& out) const {
@@ -263,10 +270,11 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
         Vec3& r = next(k, l);
         const Vec3 r_before = r;
         const Vec3 v_before = velocity_(k, l);
-        r = s.proposed.pose.to_world(target);
-        velocity_(k, l) =
-            v_before + velocity_change(s, r, s.proposed.pose.direction_to_world(normal),
-                                       v_before, node_mass_);
+        const Vec3 point = s.proposed.pose.to_world(target);
+        const Vec3 n = s.proposed.pose.direction_to_world(normal);
+        const Vec3 change = velocity_change(s, point, n, v_before, node_mass_);
+        r = point + slip_correction(change, n);
+        velocity_(k, l) = v_before + change;
         touched_(k, l) = 1;
         record(i, pass, 0, k, l, r_before, v_before, r, row);
       }
@@ -322,9 +330,9 @@ void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
         CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(tri)];
         push.active = true;
         push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
-        push.move = (offset - c.distance) * normal;
         push.velocity_change = velocity_change(s, s.proposed.pose.to_world(point), normal,
                                                velocity, s_mass / squares);
+        push.move = (offset - c.distance) * normal + slip_correction(push.velocity_change, normal);
       }
   // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
   struct Around {
@@ -386,6 +394,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
                               Field<Vec3>& next, const Field<Vec3>* next_velocities,
                               std::vector<NodeVelocity>& corrected) {
   const Block& b = *block_;
+  dt_ = dt;
   for (Solid& s : solids_) {
     if (s.spec.motion == SolidMotion::free)
       propose_free(s, dt);

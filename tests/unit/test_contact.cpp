@@ -118,7 +118,7 @@ double rebound_height(Integrator integrator, double restitution, double dt) {
     EXPECT_FALSE(sim.step());
     const double y = lowest_y(sim);
     EXPECT_GE(y, -1e-12);
-    if (y < 0.05) hit = true;
+    if (y < 1e-9) hit = true;
     if (hit) highest_after_impact = std::max(highest_after_impact, y);
   }
   EXPECT_TRUE(hit);
@@ -148,30 +148,49 @@ TEST(Contact, AFastSheetDoesNotPassThroughAThinPlane) {
   Simulation sim(scene, MPI_COMM_SELF);
   for (int i = 0; i < 20; ++i) {
     ASSERT_FALSE(sim.step());
-    EXPECT_GE(lowest_y(sim), 0.0);
+    // On the plane to round-off: the response puts nodes at distance 0.
+    EXPECT_GE(lowest_y(sim), -1e-15);
   }
-  EXPECT_LE(sim.contact_summary().max_penetration, 0.0);
+  EXPECT_LE(sim.contact_summary().max_penetration, 1e-15);
+}
+
+// The distance from p to triangle (a, b, c), by sampling it finely: independent of the
+// geometry module's closest-point code.
+double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const int n = 400;
+  double best = std::numeric_limits<double>::infinity();
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; i + j <= n; ++j) {
+      const double u = static_cast<double>(i) / n, v = static_cast<double>(j) / n;
+      best = std::min(best, norm(a + u * (b - a) + v * (c - a) - p));
+    }
+  return best;
 }
 
 // A sphere far smaller than the grid spacing under the middle of a cell: no node ever touches
-// it, so only the cell test (CONTACT.md §2, between nodes) can carry the sheet.
+// it, so only the cell test (CONTACT.md §2, between nodes) can carry the sheet; without it the
+// sheet falls past (0.7 m in 0.4 s).
 TEST(Contact, ASphereSmallerThanACellCarriesTheSheet) {
-  Scene scene = sheet_at(6, 1.0, 0.1);  // h = 0.2 m
+  Scene scene = sheet_at(6, 1.0, 0.1);  // h = 0.2 m; cell (2, 2) spans x, z in [−0.1, 0.1]
   scene.gravity = {0.0, -9.81, 0.0};
   scene.dt = 1e-3;
-  SolidSpec ball = sphere({0.1, 0.0, 0.1}, 0.02);  // the centre of cell (2, 2)
+  const double radius = 0.02;
+  SolidSpec ball = sphere({0.0, 0.0, 0.0}, radius);
   ball.thickness = 1e-3;
   scene.solids.push_back(ball);
-  SolidSpec floor = plane({0.0, -0.5, 0.0}, {0.0, 1.0, 0.0});
-  scene.solids.push_back(floor);
   Simulation sim(scene, MPI_COMM_SELF);
-  ASSERT_TRUE(testing::advance(sim, 400));
-  // Without the cell test the middle of the sheet would be on the floor at y = −0.5.
-  const Block& b = sim.block();
-  const Vec3 a = sim.positions()(2, 2), c = sim.positions()(3, 3);
-  const Vec3 middle = 0.5 * (a + c);
-  EXPECT_GT(middle.y, 0.0) << "the sheet fell past the small sphere";
-  (void)b;
+  for (int i = 0; i < 400; ++i) {
+    ASSERT_FALSE(sim.step());
+    const Field<Vec3>& r = sim.positions();
+    for (int l = 1; l < 4; ++l)
+      for (int k = 1; k < 4; ++k) {
+        const Vec3 a = r(k, l), b = r(k + 1, l), c = r(k + 1, l + 1), d = r(k, l + 1);
+        ASSERT_GT(distance_to_triangle({}, a, b, c), radius) << "cell " << k << ", " << l;
+        ASSERT_GT(distance_to_triangle({}, a, c, d), radius) << "cell " << k << ", " << l;
+      }
+  }
+  for (int l = 2; l < 4; ++l)
+    for (int k = 2; k < 4; ++k) EXPECT_GT(sim.positions()(k, l).y, -0.1) << k << ", " << l;
 }
 
 // Momentum (CONTACT.md §3): without gravity or held nodes, a free sphere hitting a free sheet
@@ -193,7 +212,7 @@ TEST(Contact, AFreeBodyAndTheSheetExchangeMomentumExactly) {
   ball.thickness = 1e-3;
   scene.solids.push_back(ball);
   Simulation sim(scene, MPI_COMM_SELF);
-  const double m = scene.material.mass / (scene.m * scene.n);
+  const double m = sim.node_mass();
   const auto totals = [&](Vec3& p, Vec3& l, double& kinetic) {
     const Block& b = sim.block();
     p = l = {};
@@ -238,12 +257,20 @@ TEST_P(EverySchemeOnASphere, NoNodeEndsAStepInsideTheSphere) {
   Scene scene = sheet_at(11, 1.0, 0.35);
   scene.integrator = GetParam();
   scene.gravity = {0.0, -9.81, 0.0};
-  scene.dt = 5e-4;
+  scene.damping = 0.5;
+  // euler and midpoint are unstable on this sheet at 5e-4 s, with or without the sphere.
+  scene.dt = scene.integrator == Integrator::euler      ? 2.5e-5
+             : scene.integrator == Integrator::midpoint ? 1e-4
+                                                        : 5e-4;
+  // The sheet reaches the sphere at 0.1 s; euler, unstable on it at any step sooner or
+  // later, stops at 0.2 s.
+  const double duration = scene.integrator == Integrator::euler ? 0.2 : 0.3;
+  const long steps = std::lround(duration / scene.dt);
   SolidSpec ball = sphere({0.0, 0.0, 0.0}, 0.3);
   ball.thickness = 2e-3;
   scene.solids.push_back(ball);
   Simulation sim(scene, MPI_COMM_SELF, any_scheme);
-  for (int i = 0; i < 600; ++i) {
+  for (long i = 0; i < steps; ++i) {
     ASSERT_FALSE(sim.step()) << "step " << i;
     const Block& b = sim.block();
     for (int l = b.l0; l < b.l1; ++l)

@@ -81,6 +81,7 @@ class Contact {
   void propose_free(Solid& s, double dt) const;
   Vec3 velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
                        const Vec3& velocity, double point_mass) const;
+  Vec3 slip_correction(const Vec3& change, const Vec3& normal) const;
   void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
   void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
@@ -97,6 +98,7 @@ class Contact {
   double node_mass_;
   Vec3 gravity_;
   double spacing_;
+  double dt_ = 0.0;  // of the step being proposed
   bool any_free_ = false;
   Field<Vec3> velocity_;           // the nodes' velocities during a response
   Field<unsigned char> touched_;   // nodes the response changed

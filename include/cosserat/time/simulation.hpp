@@ -54,6 +54,8 @@ class Simulation {
   long step_index() const { return stepper_.step_index(); }
   double time() const { return stepper_.time(); }
   const Block& block() const { return block_; }
+  // The lumped mass of every node (kg).
+  double node_mass() const { return dynamics_.node_mass(); }
   const Field<Vec3>& positions() const { return stepper_.positions(); }
   const Field<Vec3>& velocities() { return stepper_.velocities(); }
   // Wall time this rank spent in halo exchanges so far.
