@@ -150,9 +150,9 @@ void check_outline(const SolidOutline& solid, std::size_t index) {
                         vertex, vertices));
 }
 
-// world = position + R local, R formed once per pose from the quaternion (normalised, as a
-// rotation by a unit quaternion): the placement Pose::to_world makes, without the writer
-// needing the contact library.
+// world = position + R local: the placement Pose::to_world makes, with R formed once per pose
+// rather than a quaternion product per vertex, and without the writer needing the contact
+// library. Dividing by |q|² keeps R a rotation for a quaternion off unit length by rounding.
 std::vector<double> placed_vertices(const Pose& pose, const std::vector<Vec3>& local) {
   const Quaternion& q = pose.orientation;
   const double s = 2.0 / (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
@@ -232,8 +232,8 @@ SolidSeries create_solid(const hdf5::File& file, std::size_t index, const SolidO
   const std::array<hsize_t, 2> surface_shape{nv, 3};
   const std::array<hsize_t, 3> surface_chunk{1, std::min(nv, max_vertices), 3};
   const std::array<hsize_t, 1> three{3}, four{4};
-  const std::array<hsize_t, 2> position_chunk{series_chunk[0], 3}, orientation_chunk{
-                                                                        series_chunk[0], 4};
+  const std::array<hsize_t, 2> position_chunk{series_chunk[0], 3};
+  const std::array<hsize_t, 2> orientation_chunk{series_chunk[0], 4};
   return SolidSeries{
       create_series(file, (group + "/position").c_str(), H5T_IEEE_F64LE, three, position_chunk),
       create_series(file, (group + "/orientation").c_str(), H5T_IEEE_F64LE, four,
