@@ -78,25 +78,36 @@ void resize_series(const hdf5::File& file, const Handle& dataset, hsize_t frames
   file.check(H5Dset_extent(dataset.get(), extent.data()), what + " (extent)");
 }
 
-// Writes one value of a one-dimensional series at `frame`: rank 0 writes, the others take part
-// in the collective call with an empty selection.
-void write_series_value(const hdf5::File& file, const Handle& dataset, hsize_t frame,
-                        hid_t memory_type, const void* value, bool writer,
-                        const std::string& what) {
+// Writes `values` as the slab [start, start + count) of a dataset whose every rank holds the
+// same data: rank 0 (`writer`) writes, the others take part in the collective call with an
+// empty selection.
+void write_replicated(const hdf5::File& file, const Handle& dataset,
+                      std::span<const hsize_t> start, std::span<const hsize_t> count,
+                      hid_t memory_type, const void* values, bool writer,
+                      const std::string& what) {
   const Handle file_space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
-  const hsize_t one = 1;
-  const Handle memory_space = file.open(H5Screate_simple(1, &one, nullptr), H5Sclose, what);
+  const Handle memory_space =
+      file.open(H5Screate_simple(static_cast<int>(count.size()), count.data(), nullptr),
+                H5Sclose, what);
   if (writer) {
-    file.check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, &frame, nullptr, &one,
-                                   nullptr),
+    file.check(H5Sselect_hyperslab(file_space.get(), H5S_SELECT_SET, start.data(), nullptr,
+                                   count.data(), nullptr),
                what + " (select)");
   } else {
     file.check(H5Sselect_none(file_space.get()), what + " (select)");
     file.check(H5Sselect_none(memory_space.get()), what + " (select)");
   }
   file.check(H5Dwrite(dataset.get(), memory_type, memory_space.get(), file_space.get(),
-                      file.collective(), value),
+                      file.collective(), values),
              what);
+}
+
+// Writes one value of a one-dimensional series at `frame`.
+void write_series_value(const hdf5::File& file, const Handle& dataset, hsize_t frame,
+                        hid_t memory_type, const void* value, bool writer,
+                        const std::string& what) {
+  const std::array<hsize_t, 1> at{frame}, one{1};
+  write_replicated(file, dataset, at, one, memory_type, value, writer, what);
 }
 
 template <class T>
@@ -113,6 +124,150 @@ std::vector<T> read_series(const hdf5::File& file, const Handle& dataset, hid_t 
   return values;
 }
 
+// --- Rigid solids (CONTACT.md §5): replicated on every rank, so rank 0 writes their data; the
+// creation and extension of their datasets is collective like every other's.
+
+// One solid's frames: its pose and its surface placed by that pose.
+struct SolidSeries {
+  Handle position;
+  Handle orientation;
+  Handle world_vertices;
+};
+
+std::string solid_group(std::size_t index) { return fmt::format("/solids/{}", index); }
+
+void check_outline(const SolidOutline& solid, std::size_t index) {
+  const TriangleMesh& surface = solid.surface;
+  if (surface.triangles.empty())
+    throw std::invalid_argument(
+        fmt::format("solid {} ('{}'): its surface has no triangles to write", index, solid.name));
+  const auto vertices = static_cast<long>(surface.vertices.size());
+  for (const auto& triangle : surface.triangles)
+    for (const int vertex : triangle)
+      if (vertex < 0 || vertex >= vertices)
+        throw std::invalid_argument(
+            fmt::format("solid {} ('{}'): a triangle names vertex {} of {}", index, solid.name,
+                        vertex, vertices));
+}
+
+// world = position + R local: the placement Pose::to_world makes, with R formed once per pose
+// rather than a quaternion product per vertex, and without the writer needing the contact
+// library. Dividing by |q|² keeps R a rotation for a quaternion off unit length by rounding.
+std::vector<double> placed_vertices(const Pose& pose, const std::vector<Vec3>& local) {
+  const Quaternion& q = pose.orientation;
+  const double s = 2.0 / (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  const std::array<Vec3, 3> rows{
+      Vec3{1.0 - s * (q.y * q.y + q.z * q.z), s * (q.x * q.y - q.w * q.z),
+           s * (q.x * q.z + q.w * q.y)},
+      Vec3{s * (q.x * q.y + q.w * q.z), 1.0 - s * (q.x * q.x + q.z * q.z),
+           s * (q.y * q.z - q.w * q.x)},
+      Vec3{s * (q.x * q.z - q.w * q.y), s * (q.y * q.z + q.w * q.x),
+           1.0 - s * (q.x * q.x + q.y * q.y)}};
+  std::vector<double> world;
+  world.reserve(3 * local.size());
+  for (const Vec3& v : local) {
+    const Vec3 p = pose.position + Vec3{dot(rows[0], v), dot(rows[1], v), dot(rows[2], v)};
+    world.insert(world.end(), {p.x, p.y, p.z});
+  }
+  return world;
+}
+
+std::vector<double> flattened(const std::vector<Vec3>& points) {
+  std::vector<double> values;
+  values.reserve(3 * points.size());
+  for (const Vec3& p : points) values.insert(values.end(), {p.x, p.y, p.z});
+  return values;
+}
+
+std::vector<std::int32_t> flattened(const std::vector<std::array<int, 3>>& triangles) {
+  std::vector<std::int32_t> values;
+  values.reserve(3 * triangles.size());
+  for (const auto& t : triangles) values.insert(values.end(), t.begin(), t.end());
+  return values;
+}
+
+// A group without time stamps, so that the same run writes the same bytes.
+void create_group(const hdf5::File& file, const std::string& name) {
+  const std::string what = fmt::format("create group {}", name);
+  const Handle properties = file.open(H5Pcreate(H5P_GROUP_CREATE), H5Pclose, what);
+  file.check(H5Pset_obj_track_times(properties.get(), false), what + " (no time stamps)");
+  file.open(H5Gcreate2(file.get(), name.c_str(), H5P_DEFAULT, properties.get(), H5P_DEFAULT),
+            H5Gclose, what);
+}
+
+// A fixed [rows, 3] dataset written whole by rank 0.
+void write_table(const hdf5::File& file, const std::string& name, hid_t file_type,
+                 hid_t memory_type, hsize_t rows, const void* values, bool writer) {
+  const std::string what = fmt::format("write dataset {}", name);
+  const std::array<hsize_t, 2> dims{rows, 3};
+  const Handle space = file.open(H5Screate_simple(2, dims.data(), nullptr), H5Sclose, what);
+  const Handle properties = file.open(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, what);
+  file.check(H5Pset_obj_track_times(properties.get(), false), what + " (no time stamps)");
+  const Handle dataset =
+      file.open(H5Dcreate2(file.get(), name.c_str(), file_type, space.get(), H5P_DEFAULT,
+                           properties.get(), H5P_DEFAULT),
+                H5Dclose, what);
+  const std::array<hsize_t, 2> origin{0, 0};
+  write_replicated(file, dataset, origin, dims, memory_type, values, writer, what);
+}
+
+SolidSeries create_solid(const hdf5::File& file, std::size_t index, const SolidOutline& solid,
+                         bool writer) {
+  const std::string group = solid_group(index);
+  create_group(file, group);
+  {
+    const Handle handle = file.open(H5Gopen2(file.get(), group.c_str(), H5P_DEFAULT), H5Gclose,
+                                    fmt::format("open group {}", group));
+    file.write_attribute(handle.get(), "name", solid.name);
+  }
+  const std::vector<double> vertices = flattened(solid.surface.vertices);
+  const std::vector<std::int32_t> triangles = flattened(solid.surface.triangles);
+  const auto nv = static_cast<hsize_t>(solid.surface.vertices.size());
+  write_table(file, group + "/vertices", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, nv, vertices.data(),
+              writer);
+  write_table(file, group + "/triangles", H5T_STD_I32LE, H5T_NATIVE_INT32,
+              static_cast<hsize_t>(solid.surface.triangles.size()), triangles.data(), writer);
+  // One frame of a surface is one chunk, as for the cloth (under HDF5's 4 GiB chunk limit).
+  constexpr hsize_t max_vertices = ((hsize_t{1} << 32) - 1) / (3 * sizeof(double));
+  const std::array<hsize_t, 2> surface_shape{nv, 3};
+  const std::array<hsize_t, 3> surface_chunk{1, std::min(nv, max_vertices), 3};
+  const std::array<hsize_t, 1> three{3}, four{4};
+  const std::array<hsize_t, 2> position_chunk{series_chunk[0], 3};
+  const std::array<hsize_t, 2> orientation_chunk{series_chunk[0], 4};
+  return SolidSeries{
+      create_series(file, (group + "/position").c_str(), H5T_IEEE_F64LE, three, position_chunk),
+      create_series(file, (group + "/orientation").c_str(), H5T_IEEE_F64LE, four,
+                    orientation_chunk),
+      create_series(file, (group + "/world_vertices").c_str(), H5T_IEEE_F64LE, surface_shape,
+                    surface_chunk)};
+}
+
+template <class T>
+std::vector<T> read_whole(const hdf5::File& file, const std::string& name, hid_t memory_type,
+                          std::vector<hsize_t>& shape, const std::string& what) {
+  const Handle dataset = file.open(H5Dopen2(file.get(), name.c_str(), H5P_DEFAULT), H5Dclose,
+                                   fmt::format("{}: open {}", what, name));
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  const int rank = file.check(H5Sget_simple_extent_ndims(space.get()), what);
+  shape.assign(static_cast<std::size_t>(rank), 0);
+  file.check(H5Sget_simple_extent_dims(space.get(), shape.data(), nullptr), what);
+  hsize_t count = 1;
+  for (const hsize_t d : shape) count *= d;
+  std::vector<T> values(count);
+  if (count > 0)
+    file.check(H5Dread(dataset.get(), memory_type, H5S_ALL, H5S_ALL, file.collective(),
+                       values.data()),
+               fmt::format("{}: read {}", what, name));
+  return values;
+}
+
+hsize_t frames_of(const hdf5::File& file, const Handle& dataset, const std::string& what) {
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  std::array<hsize_t, 4> extent{};
+  file.check(H5Sget_simple_extent_dims(space.get(), extent.data(), nullptr), what);
+  return extent[0];
+}
+
 }  // namespace
 
 // Members close in reverse order: datasets before the file.
@@ -120,6 +275,7 @@ struct FrameWriter::Datasets {
   Handle positions;
   Handle time;
   Handle step;
+  std::vector<SolidSeries> solids{};
 };
 
 std::string xdmf_path(const std::string& h5_path) {
@@ -128,14 +284,17 @@ std::string xdmf_path(const std::string& h5_path) {
 
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
                          const std::string& scene_text, const std::string& integrator,
-                         const std::string& version, const std::vector<std::string>& overrides)
+                         const std::string& version, const std::vector<std::string>& overrides,
+                         const std::vector<SolidOutline>& solids)
     : block_(&block),
       h5_path_(h5_path),
       xmf_path_(xdmf_path(h5_path)),
-      rank_(rank_in(block.comm)) {
+      rank_(rank_in(block.comm)),
+      solids_(solids) {
   if (block.m < 1 || block.n < 1)
     throw std::runtime_error(fmt::format("HDF5 file '{}': grid {} x {} has no nodes to write",
                                          h5_path, block.m, block.n));
+  for (std::size_t i = 0; i < solids.size(); ++i) check_outline(solids[i], i);
   file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::create);
   datasets_ = std::make_unique<Datasets>(Datasets{
       create_series(*file_, "/positions", H5T_IEEE_F64LE, node_shape(block.m, block.n),
@@ -146,16 +305,20 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
   file_->write_attribute("integrator", integrator);
   file_->write_attribute("version", version);
   file_->write_attribute("overrides", join_lines(overrides));
+  if (!solids.empty()) create_group(*file_, "/solids");
+  for (std::size_t i = 0; i < solids.size(); ++i)
+    datasets_->solids.push_back(create_solid(*file_, i, solids[i], rank_ == 0));
   file_->flush();
 }
 
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step,
                          const std::string& scene_text, long last_scheduled_frame,
-                         double last_scheduled_time)
+                         double last_scheduled_time, const std::vector<SolidOutline>& solids)
     : block_(&block),
       h5_path_(h5_path),
       xmf_path_(xdmf_path(h5_path)),
-      rank_(rank_in(block.comm)) {
+      rank_(rank_in(block.comm)),
+      solids_(solids) {
   file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::read_write);
   const std::string what = "reopen for a restart";
   auto open = [&](const char* name) {
@@ -195,32 +358,114 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
                        "frame of t = {} s: the frames between would be missing",
                        times_.back(), step, last_scheduled_time));
   const auto kept = static_cast<hsize_t>(steps_.size());
+  // The same solids, each with every kept frame (a run killed inside a frame's write may have
+  // extended some series and not others).
+  const bool has_solids = file_->check(H5Lexists(file_->get(), "solids", H5P_DEFAULT), what) > 0;
+  if (has_solids && solids.empty()) refuse("it holds solids and this run has none");
+  if (!solids.empty()) {
+    if (!has_solids) refuse(fmt::format("it holds no solids and this run has {}", solids.size()));
+    H5G_info_t info{};
+    file_->check(H5Gget_info_by_name(file_->get(), "solids", &info, H5P_DEFAULT), what);
+    if (info.nlinks != solids.size())
+      refuse(fmt::format("it holds {} solids, this run {}", info.nlinks, solids.size()));
+  }
+  for (std::size_t i = 0; i < solids.size(); ++i) {
+    const std::string group = solid_group(i);
+    if (H5Lexists(file_->get(), group.c_str(), H5P_DEFAULT) <= 0)
+      refuse(fmt::format("it has no solid {} ({})", i, group));
+    {
+      const Handle handle = file_->open(H5Gopen2(file_->get(), group.c_str(), H5P_DEFAULT),
+                                        H5Gclose, fmt::format("{}: open {}", what, group));
+      const std::string name = file_->read_string_attribute(handle.get(), "name");
+      if (name != solids[i].name)
+        refuse(fmt::format("its solid {} is '{}', this run's '{}'", i, name, solids[i].name));
+    }
+    std::vector<hsize_t> shape;
+    const auto vertices = read_whole<double>(*file_, group + "/vertices", H5T_NATIVE_DOUBLE,
+                                             shape, what);
+    const auto triangles = read_whole<std::int32_t>(*file_, group + "/triangles",
+                                                    H5T_NATIVE_INT32, shape, what);
+    if (vertices != flattened(solids[i].surface.vertices) ||
+        triangles != flattened(solids[i].surface.triangles))
+      refuse(fmt::format("the surface of its solid {} ('{}') is not this run's", i,
+                         solids[i].name));
+    datasets_->solids.push_back(SolidSeries{open((group + "/position").c_str()),
+                                            open((group + "/orientation").c_str()),
+                                            open((group + "/world_vertices").c_str())});
+  }
+  auto check_frames = [&](const Handle& dataset, const std::string& name) {
+    const hsize_t frames = frames_of(*file_, dataset, what);
+    if (frames < kept)
+      refuse(fmt::format("its {} holds {} frames, fewer than the {} it keeps", name, frames, kept));
+  };
+  check_frames(datasets_->positions, "/positions");
+  for (std::size_t i = 0; i < datasets_->solids.size(); ++i) {
+    const SolidSeries& solid = datasets_->solids[i];
+    check_frames(solid.position, solid_group(i) + "/position");
+    check_frames(solid.orientation, solid_group(i) + "/orientation");
+    check_frames(solid.world_vertices, solid_group(i) + "/world_vertices");
+  }
+
   resize_series(*file_, datasets_->positions, kept, what);
   resize_series(*file_, datasets_->time, kept, what);
   resize_series(*file_, datasets_->step, kept, what);
+  for (const SolidSeries& solid : datasets_->solids) {
+    resize_series(*file_, solid.position, kept, what);
+    resize_series(*file_, solid.orientation, kept, what);
+    resize_series(*file_, solid.world_vertices, kept, what);
+  }
   file_->write_attribute("status", std::string("running (restarted)"));
   file_->flush();
   // Written whole once, for the frames kept: it may describe the dropped ones, or be the partial
   // file of a run killed while appending.
   if (rank_ == 0)
-    xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block.m, block.n, times_);
+    xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block.m, block.n, times_,
+                                       xdmf_solids());
 }
 
 FrameWriter::~FrameWriter() = default;
 
-void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positions) {
+void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positions,
+                              const std::vector<Pose>& solid_poses) {
   const auto frame = static_cast<hsize_t>(steps_.size());
   const std::string what = fmt::format("write frame {}", frame);
+  if (solid_poses.size() != solids_.size())
+    throw std::invalid_argument(fmt::format("HDF5 file '{}': {}: {} solid poses for {} solids",
+                                            h5_path_, what, solid_poses.size(), solids_.size()));
   const std::int64_t step_value = step;
   resize_series(*file_, datasets_->positions, frame + 1, what);
   resize_series(*file_, datasets_->time, frame + 1, what);
   resize_series(*file_, datasets_->step, frame + 1, what);
+  for (const SolidSeries& solid : datasets_->solids) {
+    resize_series(*file_, solid.position, frame + 1, what);
+    resize_series(*file_, solid.orientation, frame + 1, what);
+    resize_series(*file_, solid.world_vertices, frame + 1, what);
+  }
   const std::array<hsize_t, 1> at{frame};
   file_->write_block(datasets_->positions.get(), positions, at, what + " of /positions");
   write_series_value(*file_, datasets_->time, frame, H5T_NATIVE_DOUBLE, &time, rank_ == 0,
                      what + " of /time");
   write_series_value(*file_, datasets_->step, frame, H5T_NATIVE_INT64, &step_value, rank_ == 0,
                      what + " of /step");
+  for (std::size_t i = 0; i < solids_.size(); ++i) {
+    const Pose& pose = solid_poses[i];
+    const SolidSeries& solid = datasets_->solids[i];
+    const std::string of = fmt::format("{} of {}/", what, solid_group(i));
+    const std::array<double, 3> position{pose.position.x, pose.position.y, pose.position.z};
+    const std::array<double, 4> orientation{pose.orientation.w, pose.orientation.x,
+                                            pose.orientation.y, pose.orientation.z};
+    const std::vector<double> world = placed_vertices(pose, solids_[i].surface.vertices);
+    const std::array<hsize_t, 2> row{frame, 0};
+    const std::array<hsize_t, 2> three{1, 3}, four{1, 4};
+    write_replicated(*file_, solid.position, row, three, H5T_NATIVE_DOUBLE, position.data(),
+                     rank_ == 0, of + "position");
+    write_replicated(*file_, solid.orientation, row, four, H5T_NATIVE_DOUBLE,
+                     orientation.data(), rank_ == 0, of + "orientation");
+    const std::array<hsize_t, 3> surface_at{frame, 0, 0};
+    const std::array<hsize_t, 3> surface_count{1, solids_[i].surface.vertices.size(), 3};
+    write_replicated(*file_, solid.world_vertices, surface_at, surface_count, H5T_NATIVE_DOUBLE,
+                     world.data(), rank_ == 0, of + "world_vertices");
+  }
   file_->flush();
 
   times_.push_back(time);
@@ -229,7 +474,16 @@ void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positio
   if (xdmf_)
     xdmf_->append(time);
   else
-    xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block_->m, block_->n, times_);
+    xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block_->m, block_->n, times_,
+                                       xdmf_solids());
+}
+
+std::vector<XdmfSolid> FrameWriter::xdmf_solids() const {
+  std::vector<XdmfSolid> solids;
+  for (const SolidOutline& solid : solids_)
+    solids.push_back(XdmfSolid{solid.name, static_cast<long>(solid.surface.vertices.size()),
+                               static_cast<long>(solid.surface.triangles.size())});
+  return solids;
 }
 
 std::string FrameWriter::h5_filename() const {

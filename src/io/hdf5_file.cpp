@@ -57,16 +57,16 @@ void File::fail(const std::string& operation) const {
 
 namespace {
 
-// Replaces a root attribute of a fixed type with a scalar value.
-void write_scalar(const File& file, const std::string& name, hid_t file_type, hid_t memory_type,
-                  const void* value) {
+// Replaces an attribute of a fixed type of `object` (the file: its root) with a scalar value.
+void write_scalar(const File& file, hid_t object, const std::string& name, hid_t file_type,
+                  hid_t memory_type, const void* value) {
   const std::string what = fmt::format("write attribute '{}'", name);
-  const htri_t exists = H5Aexists(file.get(), name.c_str());
+  const htri_t exists = H5Aexists(object, name.c_str());
   file.check(exists, what + " (look up)");
-  if (exists > 0) file.check(H5Adelete(file.get(), name.c_str()), what + " (delete old)");
+  if (exists > 0) file.check(H5Adelete(object, name.c_str()), what + " (delete old)");
   const Handle space = file.open(H5Screate(H5S_SCALAR), H5Sclose, what);
   const Handle attribute = file.open(
-      H5Acreate2(file.get(), name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+      H5Acreate2(object, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
       H5Aclose, what);
   file.check(H5Awrite(attribute.get(), memory_type, value), what);
 }
@@ -84,17 +84,22 @@ Handle string_type(const File& file, const std::string& what) {
 // The text lives in the global heap, so a scene of any length fits; an attribute stored in the
 // object header is limited to 64 KiB.
 void File::write_attribute(const std::string& name, const std::string& value) const {
+  write_attribute(file_.get(), name, value);
+}
+
+void File::write_attribute(hid_t object, const std::string& name,
+                           const std::string& value) const {
   const Handle type = string_type(*this, fmt::format("write attribute '{}'", name));
   const char* text = value.c_str();
-  write_scalar(*this, name, type.get(), type.get(), &text);
+  write_scalar(*this, object, name, type.get(), type.get(), &text);
 }
 
 void File::write_attribute(const std::string& name, std::int64_t value) const {
-  write_scalar(*this, name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
+  write_scalar(*this, file_.get(), name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
 }
 
 void File::write_attribute(const std::string& name, double value) const {
-  write_scalar(*this, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+  write_scalar(*this, file_.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
 }
 
 void File::write_attribute(const std::string& name, const std::vector<double>& values) const {
@@ -112,15 +117,20 @@ void File::write_attribute(const std::string& name, const std::vector<double>& v
 
 namespace {
 
-Handle open_attribute(const File& file, const std::string& name, const std::string& what) {
-  return file.open(H5Aopen(file.get(), name.c_str(), H5P_DEFAULT), H5Aclose, what);
+Handle open_attribute(const File& file, hid_t object, const std::string& name,
+                      const std::string& what) {
+  return file.open(H5Aopen(object, name.c_str(), H5P_DEFAULT), H5Aclose, what);
 }
 
 }  // namespace
 
 std::string File::read_string_attribute(const std::string& name) const {
+  return read_string_attribute(file_.get(), name);
+}
+
+std::string File::read_string_attribute(hid_t object, const std::string& name) const {
   const std::string what = fmt::format("read attribute '{}'", name);
-  const Handle attribute = open_attribute(*this, name, what);
+  const Handle attribute = open_attribute(*this, object, name, what);
   const Handle type = string_type(*this, what);
   char* text = nullptr;
   check(H5Aread(attribute.get(), type.get(), &text), what);
@@ -131,7 +141,7 @@ std::string File::read_string_attribute(const std::string& name) const {
 
 std::int64_t File::read_int_attribute(const std::string& name) const {
   const std::string what = fmt::format("read attribute '{}'", name);
-  const Handle attribute = open_attribute(*this, name, what);
+  const Handle attribute = open_attribute(*this, file_.get(), name, what);
   std::int64_t value = 0;
   check(H5Aread(attribute.get(), H5T_NATIVE_INT64, &value), what);
   return value;
@@ -156,7 +166,7 @@ std::vector<double> File::read_doubles_attribute(const std::string& name) const 
 
 double File::read_double_attribute(const std::string& name) const {
   const std::string what = fmt::format("read attribute '{}'", name);
-  const Handle attribute = open_attribute(*this, name, what);
+  const Handle attribute = open_attribute(*this, file_.get(), name, what);
   double value = 0.0;
   check(H5Aread(attribute.get(), H5T_NATIVE_DOUBLE, &value), what);
   return value;

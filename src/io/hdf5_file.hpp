@@ -81,6 +81,9 @@ class File {
   void write_attribute(const std::string& name, double value) const;
   void write_attribute(const std::string& name, const std::vector<double>& values) const;
   std::string read_string_attribute(const std::string& name) const;
+  // The same on a group or dataset of the file.
+  void write_attribute(hid_t object, const std::string& name, const std::string& value) const;
+  std::string read_string_attribute(hid_t object, const std::string& name) const;
   bool has_attribute(const std::string& name) const;
   std::int64_t read_int_attribute(const std::string& name) const;
   double read_double_attribute(const std::string& name) const;

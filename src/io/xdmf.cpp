@@ -63,6 +63,53 @@ std::string frame_grid(const std::string& h5_file, int m, int n, std::size_t fra
       fmt::arg("m", m), fmt::arg("n", n), fmt::arg("file", h5_file));
 }
 
+// With solids, a frame is a spatial collection: the cloth's grid as above (without its own time,
+// which the collection carries) and one triangle surface per solid, its vertices the slab
+// [frame, 0:nv, 0:3] of /solids/<i>/world_vertices in the same XDMF 3 form.
+std::string frame_collection(const std::string& h5_file, int m, int n,
+                             const std::vector<XdmfSolid>& solids, std::size_t frame,
+                             double time) {
+  std::string grid = fmt::format(
+      R"(      <Grid Name="frame_{frame}" GridType="Collection" CollectionType="Spatial">
+        <Time Value="{time}"/>
+        <Grid Name="cloth" GridType="Uniform">
+          <Topology TopologyType="2DSMesh" Dimensions="{m} {n}"/>
+          <Geometry GeometryType="XYZ">
+            <DataItem Dimensions="{m} {n} 3" NumberType="Float" Precision="8"
+                      Format="HDF">{file}:/positions|{frame} 0 0 0:1 1 1 1:1 {m} {n} 3:{extent} {m} {n} 3</DataItem>
+          </Geometry>
+        </Grid>
+)",
+      fmt::arg("frame", frame), fmt::arg("extent", frame + 1), fmt::arg("time", time),
+      fmt::arg("m", m), fmt::arg("n", n), fmt::arg("file", h5_file));
+  for (std::size_t i = 0; i < solids.size(); ++i) {
+    const XdmfSolid& solid = solids[i];
+    grid += fmt::format(
+        R"(        <Grid Name="{name}" GridType="Uniform">
+          <Topology TopologyType="Triangle" NumberOfElements="{nt}">
+            <DataItem Dimensions="{nt} 3" NumberType="Int" Precision="4"
+                      Format="HDF">{file}:/solids/{i}/triangles</DataItem>
+          </Topology>
+          <Geometry GeometryType="XYZ">
+            <DataItem Dimensions="{nv} 3" NumberType="Float" Precision="8"
+                      Format="HDF">{file}:/solids/{i}/world_vertices|{frame} 0 0:1 1 1:1 {nv} 3:{extent} {nv} 3</DataItem>
+          </Geometry>
+        </Grid>
+)",
+        fmt::arg("name", solid.name.empty() ? fmt::format("solid_{}", i) : xml_escaped(solid.name)),
+        fmt::arg("i", i), fmt::arg("nt", solid.triangles), fmt::arg("nv", solid.vertices),
+        fmt::arg("frame", frame), fmt::arg("extent", frame + 1), fmt::arg("file", h5_file));
+  }
+  grid += "      </Grid>\n";
+  return grid;
+}
+
+std::string frame_element(const std::string& h5_file, int m, int n,
+                          const std::vector<XdmfSolid>& solids, std::size_t frame, double time) {
+  return solids.empty() ? frame_grid(h5_file, m, n, frame, time)
+                        : frame_collection(h5_file, m, n, solids, frame, time);
+}
+
 // Writes all of `text` at `offset`; false with errno set if the file took less.
 bool write_at(int descriptor, std::string_view text, long offset) {
   std::size_t written = 0;
@@ -82,18 +129,24 @@ bool write_at(int descriptor, std::string_view text, long offset) {
 }  // namespace
 
 std::string xdmf_document(const std::string& h5_filename_relative, int m, int n,
-                          const std::vector<double>& times) {
+                          const std::vector<double>& times,
+                          const std::vector<XdmfSolid>& solids) {
   const std::string h5_file = xml_escaped(h5_filename_relative);
   std::string document(kHead);
   for (std::size_t frame = 0; frame < times.size(); ++frame)
-    document += frame_grid(h5_file, m, n, frame, times[frame]);
+    document += frame_element(h5_file, m, n, solids, frame, times[frame]);
   document += kTail;
   return document;
 }
 
 XdmfFile::XdmfFile(const std::string& xmf_path, const std::string& h5_filename_relative, int m,
-                   int n, const std::vector<double>& times)
-    : path_(xmf_path), h5_file_(xml_escaped(h5_filename_relative)), m_(m), n_(n) {
+                   int n, const std::vector<double>& times,
+                   const std::vector<XdmfSolid>& solids)
+    : path_(xmf_path),
+      h5_file_(xml_escaped(h5_filename_relative)),
+      m_(m),
+      n_(n),
+      solids_(solids) {
   // The temporary sits in the same folder so that rename() replaces within one file system,
   // which POSIX makes atomic; the descriptor follows the file to its final name.
   const std::string partial_path = xmf_path + ".partial";
@@ -101,7 +154,7 @@ XdmfFile::XdmfFile(const std::string& xmf_path, const std::string& h5_filename_r
   if (descriptor_ < 0)
     throw std::runtime_error(
         fmt::format("XDMF file '{}': cannot create it: {}", partial_path, std::strerror(errno)));
-  const std::string document = xdmf_document(h5_filename_relative, m, n, times);
+  const std::string document = xdmf_document(h5_filename_relative, m, n, times, solids);
   if (!write_at(descriptor_, document, 0)) {
     const int error = errno;
     close(descriptor_);
@@ -124,7 +177,7 @@ XdmfFile::~XdmfFile() { close(descriptor_); }
 // A write that extends the file can fail part way (a full disk); the closing tags then go back
 // where they were and the file is cut there, which needs no new space.
 void XdmfFile::append(double time) {
-  const std::string element = frame_grid(h5_file_, m_, n_, frames_, time);
+  const std::string element = frame_element(h5_file_, m_, n_, solids_, frames_, time);
   if (!write_at(descriptor_, element + std::string(kTail), tail_offset_)) {
     const int error = errno;
     const auto end = static_cast<off_t>(tail_offset_ + static_cast<long>(kTail.size()));

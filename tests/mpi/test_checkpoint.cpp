@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -259,6 +260,58 @@ TEST_F(Output, OfPRanksReadsBackEqualToOneRank) {
   if (world_rank() == 0)
     for (const char* name : {"/positions", "/time", "/step"}) {
       const auto a = dataset_bytes(parallel, name), b = dataset_bytes(serial, name);
+      equal = equal && !a.empty() && a == b;
+    }
+  MPI_Bcast(&equal, 1, MPI_INT, 0, MPI_COMM_WORLD);
+  EXPECT_TRUE(equal) << "P = " << world_size();
+}
+
+// Rigid solids are replicated on every rank and written by rank 0, inside the same collective
+// calls: the file of P ranks, written and then continued after a restart, equals one rank's.
+TEST_F(Output, WithSolidsOfPRanksReadsBackEqualToOneRank) {
+  const Scene scene = testing::odd_grid_scene(Integrator::verlet);
+  const std::string parallel = (folder_ / "parallel_solids.h5").string();
+  const std::string serial = (folder_ / "serial_solids.h5").string();
+  const TriangleMesh tetrahedron{{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                                 {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+  const std::vector<SolidOutline> solids{{"floor", tetrahedron}, {"post", tetrahedron}};
+  const auto poses = [](long step) {
+    const double turn = 1e-3 * static_cast<double>(step);
+    return std::vector<Pose>{
+        Pose{Vec3{0.0, -1.0, 0.0}, Quaternion{}},
+        Pose{Vec3{0.5, 1e-4 * static_cast<double>(step), 0.25},
+             Quaternion{std::cos(turn), 0.0, std::sin(turn), 0.0}}};
+  };
+  auto run = [&](const std::string& path, MPI_Comm comm) {
+    Simulation sim(scene, comm, any_scheme);
+    long restart_step = 0;
+    {
+      FrameWriter writer(path, sim.block(), scene.text, "verlet", "test", {}, solids);
+      writer.write_frame(sim.step_index(), sim.time(), sim.positions(), poses(sim.step_index()));
+      for (int frame = 0; frame < 3; ++frame) {
+        testing::advance(sim, scene.output_every);
+        writer.write_frame(sim.step_index(), sim.time(), sim.positions(),
+                           poses(sim.step_index()));
+        if (frame == 0) restart_step = sim.step_index();
+      }
+    }
+    // Continued from the frame after the first: the last two frames are written again.
+    FrameWriter writer(path, sim.block(), restart_step, scene.text, restart_step, 0.0, solids);
+    writer.write_frame(sim.step_index(), sim.time(), sim.positions(), poses(sim.step_index()));
+  };
+  run(parallel, MPI_COMM_WORLD);
+  if (world_rank() == 0) run(serial, MPI_COMM_SELF);
+  MPI_Barrier(MPI_COMM_WORLD);
+
+  int equal = 1;
+  if (world_rank() == 0)
+    for (const char* name :
+         {"/positions", "/time", "/step", "/solids/0/vertices", "/solids/0/triangles",
+          "/solids/0/position", "/solids/0/orientation", "/solids/0/world_vertices",
+          "/solids/1/position", "/solids/1/orientation", "/solids/1/world_vertices"}) {
+      const auto a = dataset_bytes(parallel, name), b = dataset_bytes(serial, name);
+      EXPECT_FALSE(a.empty()) << name;
+      EXPECT_EQ(a, b) << name;
       equal = equal && !a.empty() && a == b;
     }
   MPI_Bcast(&equal, 1, MPI_INT, 0, MPI_COMM_WORLD);

@@ -7,7 +7,9 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <cmath>
 
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -320,6 +322,272 @@ TEST_F(FrameWriterTest, UnwritablePathNamesTheFile) {
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find(h5), std::string::npos) << error.what();
     EXPECT_NE(std::string(error.what()).find("create file"), std::string::npos) << error.what();
+  }
+}
+
+// --- Rigid solids (CONTACT.md §5) ---
+
+// A box of half extents (a, b, c): 8 corners, 2 triangles a face.
+TriangleMesh box_surface(double a, double b, double c) {
+  TriangleMesh box;
+  for (int corner = 0; corner < 8; ++corner)
+    box.vertices.push_back(Vec3{corner & 1 ? a : -a, corner & 2 ? b : -b, corner & 4 ? c : -c});
+  box.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                   {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  return box;
+}
+
+// A sphere of latitude rings and longitude segments between two poles.
+TriangleMesh sphere_surface(double radius, int rings, int segments) {
+  TriangleMesh sphere;
+  sphere.vertices.push_back(Vec3{0.0, 0.0, radius});
+  for (int r = 1; r <= rings; ++r) {
+    const double polar = M_PI * r / (rings + 1);
+    for (int s = 0; s < segments; ++s) {
+      const double azimuth = 2.0 * M_PI * s / segments;
+      sphere.vertices.push_back(Vec3{radius * std::sin(polar) * std::cos(azimuth),
+                                     radius * std::sin(polar) * std::sin(azimuth),
+                                     radius * std::cos(polar)});
+    }
+  }
+  const int south = static_cast<int>(sphere.vertices.size());
+  sphere.vertices.push_back(Vec3{0.0, 0.0, -radius});
+  const auto ring = [&](int r, int s) { return 1 + (r - 1) * segments + (s % segments); };
+  for (int s = 0; s < segments; ++s) {
+    sphere.triangles.push_back({0, ring(1, s), ring(1, s + 1)});
+    for (int r = 1; r < rings; ++r) {
+      sphere.triangles.push_back({ring(r, s), ring(r + 1, s), ring(r + 1, s + 1)});
+      sphere.triangles.push_back({ring(r, s), ring(r + 1, s + 1), ring(r, s + 1)});
+    }
+    sphere.triangles.push_back({ring(rings, s), south, ring(rings, s + 1)});
+  }
+  return sphere;
+}
+
+std::vector<SolidOutline> two_solids() {
+  return {SolidOutline{"crate", box_surface(0.5, 0.25, 0.125)},
+          SolidOutline{"ball <1>", sphere_surface(0.3, 3, 6)}};
+}
+
+// Frame f's poses: the box moving along x and turning about z, the ball about a skew axis.
+std::vector<Pose> frame_poses(int frame) {
+  const auto turn = [](double angle, Vec3 axis) {
+    axis = axis / norm(axis);
+    const double s = std::sin(angle / 2);
+    return Quaternion{std::cos(angle / 2), s * axis.x, s * axis.y, s * axis.z};
+  };
+  return {Pose{Vec3{0.1 * frame, 1.0, -2.0}, turn(0.5 * frame, Vec3{0, 0, 1})},
+          Pose{Vec3{3.0, 0.2 * frame, 0.7}, turn(1.0 + frame, Vec3{1, 2, 3})}};
+}
+
+// The rotation by q as q (0, v) q*, written out here apart from the writer's matrix.
+Vec3 rotated(const Quaternion& q, const Vec3& v) {
+  const auto product = [](const Quaternion& a, const Quaternion& b) {
+    return Quaternion{a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+                      a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+                      a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+                      a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
+  };
+  const Quaternion r = product(product(q, Quaternion{0.0, v.x, v.y, v.z}),
+                               Quaternion{q.w, -q.x, -q.y, -q.z});
+  return Vec3{r.x, r.y, r.z};
+}
+
+std::vector<hsize_t> solid_shape(hid_t file, int solid, const char* dataset) {
+  return dataset_shape(file, ("/solids/" + std::to_string(solid) + "/" + dataset).c_str());
+}
+
+std::string group_name(hid_t file, int solid) {
+  const Hid group(H5Gopen2(file, ("/solids/" + std::to_string(solid)).c_str(), H5P_DEFAULT),
+                  H5Gclose);
+  if (!group.valid()) return "<missing group>";
+  return read_string_attribute(group.get(), "name");
+}
+
+// Frames 0 .. frames - 1 of every solid's series in `file` hold the poses of frame_poses and
+// the surfaces those poses place.
+void expect_solid_frames(hid_t file, const std::vector<SolidOutline>& solids, int frames) {
+  for (int i = 0; i < static_cast<int>(solids.size()); ++i) {
+    const std::string group = "/solids/" + std::to_string(i);
+    const auto nv = static_cast<hsize_t>(solids[i].surface.vertices.size());
+    ASSERT_EQ(solid_shape(file, i, "position"), (std::vector<hsize_t>{hsize_t(frames), 3}));
+    ASSERT_EQ(solid_shape(file, i, "orientation"), (std::vector<hsize_t>{hsize_t(frames), 4}));
+    ASSERT_EQ(solid_shape(file, i, "world_vertices"),
+              (std::vector<hsize_t>{hsize_t(frames), nv, 3}));
+    const auto position = read_all<double>(file, (group + "/position").c_str(), H5T_NATIVE_DOUBLE);
+    const auto orientation =
+        read_all<double>(file, (group + "/orientation").c_str(), H5T_NATIVE_DOUBLE);
+    const auto world =
+        read_all<double>(file, (group + "/world_vertices").c_str(), H5T_NATIVE_DOUBLE);
+    for (int f = 0; f < frames; ++f) {
+      const Pose pose = frame_poses(f)[static_cast<std::size_t>(i)];
+      const Quaternion& q = pose.orientation;
+      EXPECT_EQ(std::vector<double>(position.begin() + 3 * f, position.begin() + 3 * f + 3),
+                (std::vector<double>{pose.position.x, pose.position.y, pose.position.z}));
+      EXPECT_EQ(std::vector<double>(orientation.begin() + 4 * f, orientation.begin() + 4 * f + 4),
+                (std::vector<double>{q.w, q.x, q.y, q.z}));
+      for (hsize_t v = 0; v < nv; ++v) {
+        const Vec3 expected = pose.position + rotated(q, solids[i].surface.vertices[v]);
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(world[(f * nv + v) * 3 + c], expected[c], 1e-14)
+              << group << " frame " << f << " vertex " << v << " component " << c;
+      }
+    }
+  }
+}
+
+// Two solids over three frames: their surfaces as given, their poses and placed surfaces per
+// frame, each named in every frame of the XDMF file beside the cloth.
+TEST_F(FrameWriterTest, WritesSolidsBesideTheCloth) {
+  const fs::path h5 = directory_ / "contact.h5";
+  const Block block = Block::whole(3, 4, MPI_COMM_SELF);
+  const std::vector<SolidOutline> solids = two_solids();
+  std::vector<double> times;
+  {
+    FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {}, solids);
+    for (int frame = 0; frame < 3; ++frame) {
+      times.push_back(frame * 0.25);
+      writer.write_frame(frame * 10, times.back(), frame_field(block, frame), frame_poses(frame));
+    }
+    EXPECT_THROW(writer.write_frame(30, 1.0, frame_field(block, 3)), std::invalid_argument);
+    EXPECT_EQ(writer.frames(), 3);
+  }
+  const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  ASSERT_TRUE(file.valid());
+  const hid_t f = file.get();
+  EXPECT_EQ(dataset_shape(f, "/positions"), (std::vector<hsize_t>{3, 3, 4, 3}));
+  H5G_info_t info{};
+  ASSERT_GE(H5Gget_info_by_name(f, "/solids", &info, H5P_DEFAULT), 0);
+  EXPECT_EQ(info.nlinks, 2u);
+  for (int i = 0; i < 2; ++i) {
+    const TriangleMesh& surface = solids[static_cast<std::size_t>(i)].surface;
+    EXPECT_EQ(group_name(f, i), solids[static_cast<std::size_t>(i)].name);
+    const std::string group = "/solids/" + std::to_string(i);
+    EXPECT_EQ(solid_shape(f, i, "vertices"),
+              (std::vector<hsize_t>{surface.vertices.size(), 3}));
+    EXPECT_EQ(solid_shape(f, i, "triangles"),
+              (std::vector<hsize_t>{surface.triangles.size(), 3}));
+    std::vector<double> vertices;
+    for (const Vec3& v : surface.vertices) vertices.insert(vertices.end(), {v.x, v.y, v.z});
+    EXPECT_EQ(read_all<double>(f, (group + "/vertices").c_str(), H5T_NATIVE_DOUBLE), vertices);
+    std::vector<int> triangles;
+    for (const auto& t : surface.triangles) triangles.insert(triangles.end(), t.begin(), t.end());
+    EXPECT_EQ(read_all<int>(f, (group + "/triangles").c_str(), H5T_NATIVE_INT), triangles);
+  }
+  expect_solid_frames(f, solids, 3);
+  // Half a radian about z, spelled out: the box's corner (0.5, 0.25, 0.125) at frame 1 is at
+  // (0.1, 1, -2) + R(0.5 rad about z) corner.
+  const auto world = read_all<double>(f, "/solids/0/world_vertices", H5T_NATIVE_DOUBLE);
+  const std::size_t corner = (1 * 8 + 7) * 3;
+  EXPECT_NEAR(world[corner], 0.1 + 0.5 * std::cos(0.5) - 0.25 * std::sin(0.5), 1e-15);
+  EXPECT_NEAR(world[corner + 1], 1.0 + 0.5 * std::sin(0.5) + 0.25 * std::cos(0.5), 1e-15);
+  EXPECT_NEAR(world[corner + 2], -2.0 + 0.125, 1e-15);
+
+  const std::string xmf = read_text(directory_ / "contact.xmf");
+  std::vector<XdmfSolid> described{{"crate", 8, 12}, {"ball <1>", 20, 36}};
+  EXPECT_EQ(xmf, xdmf_document("contact.h5", 3, 4, times, described));
+  EXPECT_EQ(count_occurrences(xmf, R"(CollectionType="Spatial")"), 3);
+  EXPECT_EQ(count_occurrences(xmf, R"(TopologyType="Triangle")"), 6);
+  EXPECT_EQ(count_occurrences(xmf, R"(<Grid Name="crate" GridType="Uniform">)"), 3);
+  EXPECT_EQ(count_occurrences(xmf, R"(<Grid Name="ball &lt;1&gt;" GridType="Uniform">)"), 3);
+  EXPECT_EQ(count_occurrences(xmf, ">contact.h5:/solids/1/triangles<"), 3);
+  for (int frame = 0; frame < 3; ++frame) {
+    const std::string slab = std::to_string(frame) + " 0 0:1 1 1:1 8 3:" +
+                             std::to_string(frame + 1) + " 8 3<";
+    EXPECT_EQ(count_occurrences(xmf, ">contact.h5:/solids/0/world_vertices|" + slab), 1) << xmf;
+  }
+}
+
+TEST_F(FrameWriterTest, WithoutSolidsTheFileHasNoSolidsGroup) {
+  const fs::path h5 = directory_ / "plain.h5";
+  const Block block = Block::whole(2, 2, MPI_COMM_SELF);
+  {
+    FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {});
+    writer.write_frame(0, 0.0, frame_field(block, 0));
+  }
+  const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  EXPECT_EQ(H5Lexists(file.get(), "/solids", H5P_DEFAULT), 0);
+  EXPECT_EQ(read_text(directory_ / "plain.xmf"), xdmf_document("plain.h5", 2, 2, {0.0}));
+}
+
+TEST_F(FrameWriterTest, RefusesASolidWhoseTrianglesNameMissingVertices) {
+  const Block block = Block::whole(2, 2, MPI_COMM_SELF);
+  TriangleMesh broken = box_surface(1, 1, 1);
+  broken.triangles[3][1] = 8;
+  EXPECT_THROW(FrameWriter((directory_ / "a.h5").string(), block, "scene", "verlet", "0.1.0", {},
+                           {SolidOutline{"box", broken}}),
+               std::invalid_argument);
+  EXPECT_THROW(FrameWriter((directory_ / "b.h5").string(), block, "scene", "verlet", "0.1.0", {},
+                           {SolidOutline{"nothing", TriangleMesh{}}}),
+               std::invalid_argument);
+}
+
+// A restart keeps the solids' frames up to the checkpoint with the cloth's, drops the later
+// ones, and continues them; a file of other solids, or whose solids lack kept frames, is refused
+// and left as it was.
+TEST_F(FrameWriterTest, RestartCutsTheSolidsWithTheCloth) {
+  const fs::path h5 = directory_ / "resume.h5";
+  const Block block = Block::whole(3, 2, MPI_COMM_SELF);
+  const std::vector<SolidOutline> solids = two_solids();
+  std::vector<double> times;
+  {
+    FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {}, solids);
+    for (int frame = 0; frame < 5; ++frame) {
+      times.push_back(frame * 0.5);
+      writer.write_frame(frame * 10, times.back(), frame_field(block, frame), frame_poses(frame));
+    }
+  }
+  const auto expect_refused = [&](const std::vector<SolidOutline>& other, const char* why) {
+    try {
+      FrameWriter restarted(h5.string(), block, 25, "scene", 20, 0.0, other);
+      ADD_FAILURE() << "restart accepted " << why;
+    } catch (const std::runtime_error& error) {
+      EXPECT_NE(std::string(error.what()).find(h5.string()), std::string::npos) << error.what();
+    }
+    const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    EXPECT_EQ(dataset_shape(file.get(), "/positions")[0], 5u) << why;
+    EXPECT_EQ(solid_shape(file.get(), 1, "world_vertices")[0], 5u) << why;
+  };
+  expect_refused({}, "without solids");
+  expect_refused({solids[0]}, "with one solid of two");
+  std::vector<SolidOutline> renamed = solids;
+  renamed[1].name = "ball";
+  expect_refused(renamed, "with a renamed solid");
+  std::vector<SolidOutline> moved = solids;
+  moved[0].surface.vertices[2].y += 1e-9;
+  expect_refused(moved, "with another surface");
+
+  {
+    FrameWriter restarted(h5.string(), block, 25, "scene", 20, 0.0, solids);
+    EXPECT_EQ(restarted.frames(), 3);
+    times.resize(3);
+    EXPECT_EQ(read_text(directory_ / "resume.xmf"),
+              xdmf_document("resume.h5", 3, 2, times, {{"crate", 8, 12}, {"ball <1>", 20, 36}}));
+    {
+      const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+      expect_solid_frames(file.get(), solids, 3);
+    }
+    times.push_back(1.5);
+    restarted.write_frame(30, times.back(), frame_field(block, 3), frame_poses(3));
+  }
+  const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+  expect_solid_frames(file.get(), solids, 4);
+  EXPECT_EQ(read_text(directory_ / "resume.xmf"),
+            xdmf_document("resume.h5", 3, 2, times, {{"crate", 8, 12}, {"ball <1>", 20, 36}}));
+
+  // A run killed inside a frame's write may leave a solid's series shorter than the cloth's.
+  {
+    const Hid dataset(H5Dopen2(file.get(), "/solids/1/orientation", H5P_DEFAULT), H5Dclose);
+    const std::array<hsize_t, 2> two{2, 4};
+    ASSERT_GE(H5Dset_extent(dataset.get(), two.data()), 0);
+  }
+  H5Fflush(file.get(), H5F_SCOPE_GLOBAL);
+  try {
+    FrameWriter restarted(h5.string(), block, 25, "scene", 20, 0.0, solids);
+    ADD_FAILURE() << "restart accepted a solid missing kept frames";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("/solids/1/orientation"), std::string::npos)
+        << error.what();
   }
 }
 

@@ -3,12 +3,14 @@
 // write_frame, written collectively by every rank as its block's hyperslab (parallel HDF5),
 // appended and flushed at once, and named in the XDMF file beside it by rank 0 (one element
 // appended per frame, xdmf.hpp), so that a killed run leaves both files readable with every
-// frame written so far.
+// frame written so far. The rigid solids of a contact scene (CONTACT.md §5) are written beside
+// the cloth, from plain data (SolidOutline, Pose), by rank 0.
 
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "cosserat/contact/geometry.hpp"
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/vec3.hpp"
 
@@ -18,6 +20,14 @@ namespace hdf5 {
 class File;
 }
 class XdmfFile;
+struct XdmfSolid;
+
+// What the output needs of a rigid solid: its name and its surface in its own frame (a plane's
+// as a square, SolidGeometry::surface). The same on every rank.
+struct SolidOutline {
+  std::string name;
+  TriangleMesh surface;
+};
 
 // The XDMF file written beside the HDF5 file `h5_path`: the same name with .xmf.
 std::string xdmf_path(const std::string& h5_path);
@@ -28,28 +38,35 @@ class FrameWriter {
  public:
   // Creates h5_path (truncating an existing file) for the block's m x n grid and records the
   // scene text as read, the integrator name, the build version and the --set strings as root
-  // attributes.
+  // attributes. Each of `solids` gets its group /solids/<i> (docs/output.md); without solids
+  // the file holds no /solids. Throws std::invalid_argument for a solid without triangles or
+  // with a triangle's vertex index out of range.
   FrameWriter(const std::string& h5_path, const Block& block, const std::string& scene_text,
               const std::string& integrator, const std::string& version,
-              const std::vector<std::string>& overrides);
+              const std::vector<std::string>& overrides,
+              const std::vector<SolidOutline>& solids = {});
 
   // Reopens the output of an earlier run to continue it after a restart from `step`: the
   // frames up to that step are kept, later ones (written after the checkpoint) dropped. The file
   // must be that run's: written for `scene_text` on this grid, holding every frame up to
   // `last_scheduled_frame`, the last one the schedule put at or before `step` (with adaptive
-  // steps, whose frames are scheduled in time, up to `last_scheduled_time` instead); else it
-  // throws before changing anything.
+  // steps, whose frames are scheduled in time, up to `last_scheduled_time` instead), and
+  // holding exactly `solids` (names and surfaces) with their frames; else it throws before
+  // changing anything. The solids' frames are cut with the cloth's.
   FrameWriter(const std::string& h5_path, const Block& block, long step,
               const std::string& scene_text, long last_scheduled_frame,
-              double last_scheduled_time = 0.0);
+              double last_scheduled_time = 0.0, const std::vector<SolidOutline>& solids = {});
 
   ~FrameWriter();
   FrameWriter(const FrameWriter&) = delete;
   FrameWriter& operator=(const FrameWriter&) = delete;
 
   // Appends the owned nodes of `positions` as one frame [k][l][xyz] of /positions. The frame
-  // is on disk and named in the XDMF file when this returns.
-  void write_frame(long step, double time, const Field<Vec3>& positions);
+  // is on disk and named in the XDMF file when this returns. `solid_poses` places the solids
+  // given at construction, one pose each in their order (the same on every rank); throws
+  // std::invalid_argument, before writing, when the count differs.
+  void write_frame(long step, double time, const Field<Vec3>& positions,
+                   const std::vector<Pose>& solid_poses = {});
 
   // Writes or replaces a root string attribute, e.g. the final `status`.
   void set_attribute(const std::string& name, const std::string& value);
@@ -60,6 +77,7 @@ class FrameWriter {
  private:
   struct Datasets;
   std::string h5_filename() const;
+  std::vector<XdmfSolid> xdmf_solids() const;
 
   const Block* block_;
   std::unique_ptr<hdf5::File> file_;
@@ -68,6 +86,7 @@ class FrameWriter {
   std::string h5_path_;
   std::string xmf_path_;
   int rank_ = 0;
+  std::vector<SolidOutline> solids_;
   std::vector<double> times_;
   std::vector<long> steps_;
 };
