@@ -466,10 +466,93 @@ Weights box_deepest(const Vec3& half, const Vec3& a, const Vec3& b, const Vec3& 
   return clean(best);
 }
 
+// The smallest F = max(ρ − R, |z| − H) on the triangle (ρ the distance from the axis), which
+// is the signed distance wherever it is negative: F <= s holds somewhere on the triangle when
+// the part of it with |z| <= H + s comes within R + s of the axis, a test in the xy-plane
+// after clipping, and that is monotone in s, so bisection finds the minimum to round-off.
+// Returns the weights of a point with F <= hi, hi an F known to be reached.
+Weights cylinder_pressed(double radius, double half_length, const Vec3& a, const Vec3& b,
+                         const Vec3& c, double hi) {
+  struct Corner {
+    Vec3 x;
+    Weights w;
+  };
+  // The point of the clipped triangle nearest the axis, or nothing if the clip is empty.
+  const auto nearest_axis = [&](double s, double& rho) -> std::optional<Weights> {
+    std::vector<Corner> polygon{{a, {1, 0, 0}}, {b, {0, 1, 0}}, {c, {0, 0, 1}}};
+    for (const double side : {1.0, -1.0}) {
+      std::vector<Corner> kept;
+      for (std::size_t i = 0; i < polygon.size(); ++i) {
+        const Corner& p = polygon[i];
+        const Corner& q = polygon[(i + 1) % polygon.size()];
+        const double hp = side * p.x.z - (half_length + s);
+        const double hq = side * q.x.z - (half_length + s);
+        if (hp <= 0.0) kept.push_back(p);
+        if ((hp < 0.0 && hq > 0.0) || (hp > 0.0 && hq < 0.0)) {
+          const double t = hp / (hp - hq);
+          kept.push_back({p.x + t * (q.x - p.x),
+                          {p.w[0] + t * (q.w[0] - p.w[0]), p.w[1] + t * (q.w[1] - p.w[1]),
+                           p.w[2] + t * (q.w[2] - p.w[2])}});
+        }
+      }
+      polygon = std::move(kept);
+      if (polygon.empty()) return std::nullopt;
+    }
+    // The axis pierces the polygon's projection: some fan triangle holds the origin.
+    for (std::size_t i = 1; i + 1 < polygon.size(); ++i) {
+      const Vec3& p0 = polygon[0].x;
+      const Vec3& p1 = polygon[i].x;
+      const Vec3& p2 = polygon[i + 1].x;
+      const double area = (p1.x - p0.x) * (p2.y - p0.y) - (p1.y - p0.y) * (p2.x - p0.x);
+      if (area == 0.0) continue;
+      const double l1 = ((0.0 - p0.x) * (p2.y - p0.y) - (0.0 - p0.y) * (p2.x - p0.x)) / area;
+      const double l2 = ((p1.x - p0.x) * (0.0 - p0.y) - (p1.y - p0.y) * (0.0 - p0.x)) / area;
+      if (l1 >= 0.0 && l2 >= 0.0 && l1 + l2 <= 1.0) {
+        rho = 0.0;
+        Weights w{};
+        for (int k = 0; k < 3; ++k) {
+          w[k] = (1.0 - l1 - l2) * polygon[0].w[k] + l1 * polygon[i].w[k] + l2 * polygon[i + 1].w[k];
+        }
+        return w;
+      }
+    }
+    rho = kInfinity;
+    Weights best{};
+    for (std::size_t i = 0; i < polygon.size(); ++i) {
+      const Corner& p = polygon[i];
+      const Corner& q = polygon[(i + 1) % polygon.size()];
+      const Vec3 pf{p.x.x, p.x.y, 0.0};
+      const Vec3 qf{q.x.x, q.x.y, 0.0};
+      const double t = closest_on_segment({0.0, 0.0, 0.0}, pf, qf);
+      const double r = norm(pf + t * (qf - pf));
+      if (r < rho) {
+        rho = r;
+        for (int k = 0; k < 3; ++k) best[k] = p.w[k] + t * (q.w[k] - p.w[k]);
+      }
+    }
+    return best;
+  };
+  double lo = -std::min(radius, half_length);
+  double rho = 0.0;
+  std::optional<Weights> found = nearest_axis(hi, rho);
+  Weights best = found ? *found : Weights{1.0, 0.0, 0.0};
+  for (int iteration = 0; iteration < 100 && hi - lo > 1e-13 * (radius + half_length); ++iteration) {
+    const double mid = 0.5 * (lo + hi);
+    found = nearest_axis(mid, rho);
+    if (found && rho <= radius + mid) {
+      hi = mid;
+      best = *found;
+    } else {
+      lo = mid;
+    }
+  }
+  return clean(best);
+}
+
 // The cylinder's distance has a curved kink where side and cap meet, so no finite candidate
-// set is exact. These are exact where a side presses into the triangle (the triangle's point
-// nearest the axis) or a cap presses flat (the axis crossing it); rim samples cover a rim
-// pressing in, and compass search refines the best of them.
+// set is exact. Pressed into the cylinder the bisection above is; apart from it the distance
+// is round at the rims, so candidates (the triangle's corners, its points nearest the centre,
+// the axis and rim samples) and a compass search from the best cover that.
 Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const Vec3& b,
                          const Vec3& c) {
   std::vector<Weights> candidates{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
@@ -494,6 +577,14 @@ Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const
     if (value < best_value) {
       best_value = value;
       best = clean(w);
+    }
+  }
+  if (best_value < 0.0) {
+    const Weights pressed = cylinder_pressed(radius, half_length, a, b, c, best_value);
+    const double value = distance(pressed);
+    if (value < best_value) {
+      best_value = value;
+      best = pressed;
     }
   }
   return clean(compass_refine(best, best_value, distance));
