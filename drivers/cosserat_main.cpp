@@ -104,6 +104,25 @@ class Progress {
   Clock::time_point start_, last_;
 };
 
+// The solids as the output draws them: each surface in its own frame (a plane as a square
+// twice the sheet's size), and where each is now.
+std::vector<cosserat::SolidOutline> solid_outlines(const cosserat::Simulation& simulation,
+                                                   const cosserat::Scene& scene) {
+  std::vector<cosserat::SolidOutline> outlines;
+  if (const cosserat::Contact* contact = simulation.contact())
+    for (std::size_t i = 0; i < contact->size(); ++i)
+      outlines.push_back({contact->spec(i).name,
+                          contact->geometry(i).surface(2.0 * std::max(scene.size1, scene.size2))});
+  return outlines;
+}
+
+std::vector<cosserat::Pose> solid_poses(const cosserat::Simulation& simulation) {
+  std::vector<cosserat::Pose> poses;
+  if (const cosserat::Contact* contact = simulation.contact())
+    for (std::size_t i = 0; i < contact->size(); ++i) poses.push_back(contact->state(i).pose);
+  return poses;
+}
+
 // The step loop says when a frame or a checkpoint is due; the files and the progress line are
 // the command line's.
 class RunObserver : public cosserat::StepObserver {
@@ -117,7 +136,8 @@ class RunObserver : public cosserat::StepObserver {
         progress_(progress) {}
 
   void frame() override {
-    writer_.write_frame(simulation_.step_index(), simulation_.time(), simulation_.positions());
+    writer_.write_frame(simulation_.step_index(), simulation_.time(), simulation_.positions(),
+                        solid_poses(simulation_));
   }
   void checkpoint(const cosserat::LoopCarry& carry) override {
     cosserat::write_checkpoint(
@@ -311,11 +331,12 @@ int run(const RunOptions& options, int rank, int ranks) {
           output, simulation.block(), *restarted_from, scene.text,
           scene.adaptive ? 0 : *restarted_from - *restarted_from % scene.output_every,
           // Adaptive steps schedule frames in time.
-          scene.adaptive ? AdaptiveSteps(scene).frame_at_or_before(simulation.time()) : 0.0);
+          scene.adaptive ? AdaptiveSteps(scene).frame_at_or_before(simulation.time()) : 0.0,
+          solid_outlines(simulation, scene));
     else
       writer = std::make_unique<FrameWriter>(output, simulation.block(), scene.text,
                                              integrator_name(scene.integrator), COSSERAT_VERSION,
-                                             scene.overrides);
+                                             scene.overrides, solid_outlines(simulation, scene));
   } catch (const std::exception& e) {
     // This rank alone may have failed (rank 0 writes the XDMF file), and a file whose first
     // write failed crashes HDF5's clean-up in MPI_Finalize: end every rank now.
@@ -342,7 +363,8 @@ int run(const RunOptions& options, int rank, int ranks) {
   // A continued file already holds every scheduled frame up to the checkpoint; a new file starts
   // with the state the run starts from.
   if (!continued)
-    writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions());
+    writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions(),
+                        solid_poses(simulation));
 
   Progress progress(simulation.step_index(), simulation.time(), scene.duration, on_terminal);
   RunObserver observer(simulation, scene, *writer, checkpoint, progress);

@@ -112,12 +112,13 @@ Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double 
 
 }  // namespace
 
-// One node's change by one solid in one phase of one pass: the impulse J = m (v' − v) and the
-// change m (r' × v' − r × v) of the node's angular momentum about the origin. `key` orders the
-// sums by (pass, phase, solid, node), the same on every decomposition.
+// One node's change of velocity by a free body in one phase of one pass (CONTACT.md §3): the
+// impulse J = m (v' − v), its moment r' × J about the origin, the moment m (r' − r) × v of the
+// node's move onto the surface, and the velocity v before. `key` orders the sums by (solid,
+// node, pass, phase), the same on every decomposition, with a node's changes next to each other.
 struct Contact::Exchange {
   std::int64_t key;
-  double values[6];
+  Vec3 impulse, moment, move_moment, velocity;
 };
 
 // A cell triangle pressed into a solid: its barycentric weights at the deepest point, the move
@@ -186,25 +187,15 @@ void Contact::propose_free(Solid& s, double dt) const {
   s.proposed_pushing = s.pushing;
 }
 
-// CONTACT.md §3 at a world point of solid s with world normal n, for cloth of mass
-// `point_mass` there moving at `velocity`. Against a free body the change is that of the
-// two-body impact along n, m_eff/m of the change against an immovable surface, with
-// 1/m_eff = 1/m + 1/M + (r × n)·I⁻¹(r × n): one node meeting a body conserves energy at e = 1.
+// CONTACT.md §3 at a world point of solid s with world normal n, for cloth moving at
+// `velocity` there: the change against the solid's surface as if it could not be moved. A free
+// body's share is settled once all its contacts are known (apply_impulses).
 Vec3 Contact::velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
-                              const Vec3& velocity, double point_mass) const {
+                              const Vec3& velocity) const {
   const SolidState& body = s.proposed;
-  const Vec3 arm = point - body.pose.position;
-  const Vec3 surface = body.velocity + cross(body.angular_velocity, arm);
-  Vec3 change = respond_velocity(velocity, surface, normal, s.spec.restitution, s.spec.friction) -
-                velocity;
-  if (s.spec.motion == SolidMotion::free) {
-    const double mass = s.spec.body.mass;
-    const Vec3 lever = cross(arm, normal);
-    const double rotational =
-        dot(lever, inertia_solve(body.pose.orientation, mass * s.inertia_per_mass, lever));
-    change = (1.0 / (1.0 + point_mass * (1.0 / mass + rotational))) * change;
-  }
-  return change;
+  const Vec3 surface = body.velocity + cross(body.angular_velocity, point - body.pose.position);
+  return respond_velocity(velocity, surface, normal, s.spec.restitution, s.spec.friction) -
+         velocity;
 }
 
 // The step moved the node with its velocity before the response: friction's change of the
@@ -218,17 +209,14 @@ void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const
                      const Vec3& v_before, const Vec3& r_after,
                      std::vector<Exchange>& out) const {
   if (solids_[solid].spec.motion != SolidMotion::free) return;
-  const Vec3 v_after = velocity_(k, l);
-  const Vec3 j = node_mass_ * (v_after - v_before);
-  const Vec3 dl = node_mass_ * (cross(r_after, v_after) - cross(r_before, v_before));
+  const Vec3 j = node_mass_ * (velocity_(k, l) - v_before);
   const Block& b = *block_;
+  const std::int64_t node = static_cast<std::int64_t>(l) * b.m + k;
   const std::int64_t nodes = static_cast<std::int64_t>(b.m) * b.n;
-  const auto count = static_cast<std::int64_t>(solids_.size());
   const std::int64_t key =
-      ((static_cast<std::int64_t>(pass) * 2 + phase) * count + static_cast<std::int64_t>(solid)) *
-          nodes +
-      static_cast<std::int64_t>(l) * b.m + k;
-  out.push_back({key, {j.x, j.y, j.z, dl.x, dl.y, dl.z}});
+      ((static_cast<std::int64_t>(solid) * nodes + node) * kMaxPasses + pass) * 2 + phase;
+  out.push_back({key, j, cross(r_after, j), node_mass_ * cross(r_after - r_before, v_before),
+                 v_before});
 }
 
 // CONTACT.md §2, nodes: the segment from the node at the start of the step to its proposed end,
@@ -272,7 +260,7 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
         const Vec3 v_before = velocity_(k, l);
         const Vec3 point = s.proposed.pose.to_world(target);
         const Vec3 n = s.proposed.pose.direction_to_world(normal);
-        const Vec3 change = velocity_change(s, point, n, v_before, node_mass_);
+        const Vec3 change = velocity_change(s, point, n, v_before);
         r = point + slip_correction(change, n);
         velocity_(k, l) = v_before + change;
         touched_(k, l) = 1;
@@ -302,7 +290,6 @@ void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
     return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * 2;
   };
   cells_.assign(static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2, CellPush{});
-  const double s_mass = node_mass_;
 #pragma omp parallel for schedule(static)
   for (int lc = std::max(b.l0 - 1, 0); lc < std::min(b.l1, b.n - 1); ++lc)
     for (int kc = std::max(b.k0 - 1, 0); kc < std::min(b.k1, b.m - 1); ++kc)
@@ -330,8 +317,8 @@ void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
         CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(tri)];
         push.active = true;
         push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
-        push.velocity_change = velocity_change(s, s.proposed.pose.to_world(point), normal,
-                                               velocity, s_mass / squares);
+        push.velocity_change =
+            velocity_change(s, s.proposed.pose.to_world(point), normal, velocity);
         push.move = (offset - c.distance) * normal + slip_correction(push.velocity_change, normal);
       }
   // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
@@ -423,6 +410,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   double deepest = stats.max_penetration;
   MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
 
+  if (any_free_) apply_impulses(exchanges);
   long local = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k)
@@ -431,16 +419,20 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
         ++local;
       }
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
-  if (any_free_) apply_impulses(exchanges);
   return stats;
 }
 
-// CONTACT.md §3–§4: each free body takes −ΣJ and the angular momentum the nodes gained about
-// its centre, summed in the order of the exchanges' keys after gathering every rank's, so the
-// sum is the same on every rank and for every decomposition. The body's angular momentum
-// takes −Σ m (r' × v' − r × v) + x × ΣJ: with the linear part, cloth and body together keep
-// their momentum and angular momentum about the origin exactly up to round-off, the nodes'
-// moves onto the surface included (where a node does not move this is −Σ (r − x) × J).
+// CONTACT.md §3–§4. Each node met a free body as if it could not move, with impulse J_i; the
+// body and its nodes then share the impact as two bodies do: the nodes keep s J_i and the body
+// takes −s ΣJ_i, with one factor s for all its contacts. The kinetic energy changes by
+// ΔK(s) = s a + s² b, a = Σ J_i·(v_i − v_surface,i) < 0 for approaching nodes,
+// b = Σ|J_node|²/2m + |ΣJ|²/2M + T·I⁻¹T/2 with T = Σ (r_i − x) × J_i; s = (1 + e)/2 · (−a/b)
+// is the two-body impact with restitution e for a single contact, ΔK = s a (1 − e)/2 ≤ 0 for
+// any number of contacts, and s ≤ 1 keeps each node's response no stronger than against an
+// immovable surface. The body's angular momentum takes −Σ m (r' × v' − r × v) + x × ΣJ: with
+// the linear part, cloth and body together keep their momentum and angular momentum about the
+// origin to round-off, the nodes' moves onto the surface included. The sums run in the
+// exchanges' key order after gathering every rank's, the same on every rank and decomposition.
 void Contact::apply_impulses(std::vector<Exchange>& exchanges) {
   const MPI_Comm comm = block_->comm;
   int ranks = 1;
@@ -459,26 +451,53 @@ void Contact::apply_impulses(std::vector<Exchange>& exchanges) {
   std::sort(all.begin(), all.end(),
             [](const Exchange& a, const Exchange& b) { return a.key < b.key; });
   const auto nodes = static_cast<std::int64_t>(block_->m) * block_->n;
-  const auto count = static_cast<std::int64_t>(solids_.size());
-  std::vector<Vec3> impulse(solids_.size()), angular(solids_.size());
-  std::vector<char> touched(solids_.size(), 0);
-  for (const Exchange& e : all) {
-    const auto i = static_cast<std::size_t>((e.key / nodes) % count);
-    impulse[i] += Vec3{e.values[0], e.values[1], e.values[2]};
-    angular[i] += Vec3{e.values[3], e.values[4], e.values[5]};
-    touched[i] = 1;
-  }
-  for (std::size_t i = 0; i < solids_.size(); ++i) {
-    Solid& s = solids_[i];
-    if (s.spec.motion != SolidMotion::free || !touched[i]) continue;
-    const double mass = s.spec.body.mass;
+  const std::int64_t per_solid = nodes * kMaxPasses * 2;
+  std::vector<double> scale(solids_.size(), 1.0);
+  for (std::size_t first = 0; first < all.size();) {
+    const std::int64_t solid_key = all[first].key / per_solid;
+    Solid& s = solids_[static_cast<std::size_t>(solid_key)];
     SolidState& body = s.proposed;
+    Vec3 impulse, moment, move_moment;
+    double approach = 0.0, node_energy = 0.0;
+    std::size_t i = first;
+    while (i < all.size() && all[i].key / per_solid == solid_key) {
+      // One node's exchanges, pass after pass.
+      const std::int64_t node_key = all[i].key / (kMaxPasses * 2);
+      const Vec3 v0 = all[i].velocity;
+      Vec3 node_impulse;
+      for (; i < all.size() && all[i].key / (kMaxPasses * 2) == node_key; ++i) {
+        node_impulse += all[i].impulse;
+        moment += all[i].moment;
+        move_moment += all[i].move_moment;
+      }
+      impulse += node_impulse;
+      approach += dot(node_impulse, v0);
+      node_energy += dot(node_impulse, node_impulse) / (2.0 * node_mass_);
+    }
+    const double mass = s.spec.body.mass;
     const Vec3 moments = mass * s.inertia_per_mass;
+    const Vec3 torque = moment - cross(body.pose.position, impulse);
+    const double a = approach - dot(body.velocity, impulse) - dot(body.angular_velocity, torque);
+    const double b = node_energy + dot(impulse, impulse) / (2.0 * mass) +
+                     0.5 * dot(torque, inertia_solve(body.pose.orientation, moments, torque));
+    double share = 1.0;
+    if (a < 0.0 && b > 0.0) share = std::min(1.0, 0.5 * (1.0 + s.spec.restitution) * (-a / b));
+    scale[static_cast<std::size_t>(solid_key)] = share;
     Vec3 spin = inertia_times(body.pose.orientation, moments, body.angular_velocity);
-    spin += cross(body.pose.position, impulse[i]) - angular[i];
-    body.velocity -= impulse[i] / mass;
+    spin -= move_moment + share * torque;
+    body.velocity -= (share / mass) * impulse;
     body.angular_velocity = inertia_solve(body.pose.orientation, moments, spin);
     if (s.spec.body.force_until_contact) s.proposed_pushing = false;
+    first = i;
+  }
+  // This rank's nodes keep their share of what they exchanged.
+  const Block& b = *block_;
+  for (const Exchange& e : exchanges) {
+    const auto solid = static_cast<std::size_t>(e.key / per_solid);
+    if (scale[solid] == 1.0) continue;
+    const std::int64_t node = (e.key / (kMaxPasses * 2)) % nodes;
+    const int k = static_cast<int>(node % b.m), l = static_cast<int>(node / b.m);
+    velocity_(k, l) -= ((1.0 - scale[solid]) / node_mass_) * e.impulse;
   }
 }
 

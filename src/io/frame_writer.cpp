@@ -150,23 +150,11 @@ void check_outline(const SolidOutline& solid, std::size_t index) {
                         vertex, vertices));
 }
 
-// world = position + R local: the placement Pose::to_world makes, with R formed once per pose
-// rather than a quaternion product per vertex, and without the writer needing the contact
-// library. Dividing by |q|² keeps R a rotation for a quaternion off unit length by rounding.
 std::vector<double> placed_vertices(const Pose& pose, const std::vector<Vec3>& local) {
-  const Quaternion& q = pose.orientation;
-  const double s = 2.0 / (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  const std::array<Vec3, 3> rows{
-      Vec3{1.0 - s * (q.y * q.y + q.z * q.z), s * (q.x * q.y - q.w * q.z),
-           s * (q.x * q.z + q.w * q.y)},
-      Vec3{s * (q.x * q.y + q.w * q.z), 1.0 - s * (q.x * q.x + q.z * q.z),
-           s * (q.y * q.z - q.w * q.x)},
-      Vec3{s * (q.x * q.z - q.w * q.y), s * (q.y * q.z + q.w * q.x),
-           1.0 - s * (q.x * q.x + q.y * q.y)}};
   std::vector<double> world;
   world.reserve(3 * local.size());
   for (const Vec3& v : local) {
-    const Vec3 p = pose.position + Vec3{dot(rows[0], v), dot(rows[1], v), dot(rows[2], v)};
+    const Vec3 p = pose.to_world(v);
     world.insert(world.end(), {p.x, p.y, p.z});
   }
   return world;

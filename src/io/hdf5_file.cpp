@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <array>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -57,14 +58,17 @@ void File::fail(const std::string& operation) const {
 
 namespace {
 
-// Replaces an attribute of a fixed type of `object` (the file: its root) with a scalar value.
-void write_scalar(const File& file, hid_t object, const std::string& name, hid_t file_type,
-                  hid_t memory_type, const void* value) {
+// Replaces an attribute of a fixed type of `object` (the file: its root) with a scalar value
+// or, with `count`, a one-dimensional array of that many values.
+void write_values(const File& file, hid_t object, const std::string& name, hid_t file_type,
+                  hid_t memory_type, const void* value, std::optional<hsize_t> count = {}) {
   const std::string what = fmt::format("write attribute '{}'", name);
   const htri_t exists = H5Aexists(object, name.c_str());
   file.check(exists, what + " (look up)");
   if (exists > 0) file.check(H5Adelete(object, name.c_str()), what + " (delete old)");
-  const Handle space = file.open(H5Screate(H5S_SCALAR), H5Sclose, what);
+  const Handle space = file.open(count ? H5Screate_simple(1, &*count, nullptr)
+                                       : H5Screate(H5S_SCALAR),
+                                 H5Sclose, what);
   const Handle attribute = file.open(
       H5Acreate2(object, name.c_str(), file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
       H5Aclose, what);
@@ -91,28 +95,20 @@ void File::write_attribute(hid_t object, const std::string& name,
                            const std::string& value) const {
   const Handle type = string_type(*this, fmt::format("write attribute '{}'", name));
   const char* text = value.c_str();
-  write_scalar(*this, object, name, type.get(), type.get(), &text);
+  write_values(*this, object, name, type.get(), type.get(), &text);
 }
 
 void File::write_attribute(const std::string& name, std::int64_t value) const {
-  write_scalar(*this, file_.get(), name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
+  write_values(*this, file_.get(), name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
 }
 
 void File::write_attribute(const std::string& name, double value) const {
-  write_scalar(*this, file_.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
+  write_values(*this, file_.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &value);
 }
 
 void File::write_attribute(const std::string& name, const std::vector<double>& values) const {
-  const std::string what = fmt::format("write attribute '{}'", name);
-  const htri_t exists = H5Aexists(get(), name.c_str());
-  check(exists, what + " (look up)");
-  if (exists > 0) check(H5Adelete(get(), name.c_str()), what + " (delete old)");
-  const hsize_t size = values.size();
-  const Handle space = open(H5Screate_simple(1, &size, nullptr), H5Sclose, what);
-  const Handle attribute = open(
-      H5Acreate2(get(), name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-      H5Aclose, what);
-  check(H5Awrite(attribute.get(), H5T_NATIVE_DOUBLE, values.data()), what);
+  write_values(*this, file_.get(), name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, values.data(),
+               values.size());
 }
 
 namespace {
@@ -155,7 +151,7 @@ bool File::has_attribute(const std::string& name) const {
 
 std::vector<double> File::read_doubles_attribute(const std::string& name) const {
   const std::string what = fmt::format("read attribute '{}'", name);
-  const Handle attribute = open_attribute(*this, name, what);
+  const Handle attribute = open_attribute(*this, file_.get(), name, what);
   const Handle space = open(H5Aget_space(attribute.get()), H5Sclose, what);
   const hssize_t size = H5Sget_simple_extent_npoints(space.get());
   check(static_cast<hid_t>(size), what + " (size)");

@@ -80,7 +80,7 @@ class Contact {
 
   void propose_free(Solid& s, double dt) const;
   Vec3 velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
-                       const Vec3& velocity, double point_mass) const;
+                       const Vec3& velocity) const;
   Vec3 slip_correction(const Vec3& change, const Vec3& normal) const;
   void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
