@@ -110,6 +110,18 @@ Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double 
 }
 
 
+// How far along unit direction n point p (in the shape's frame) must move to be `offset` clear
+// of the shape: bisection on the signed distance, from a bound where the ball holding the shape
+// is left behind.
+double clearance(const SolidGeometry& g, const Vec3& p, const Vec3& n, double offset) {
+  double inside = 0.0, outside = norm(p) + g.bounding_radius() + offset;
+  for (int i = 0; i < 60; ++i) {
+    const double t = 0.5 * (inside + outside);
+    (g.closest(p + t * n).distance >= offset ? outside : inside) = t;
+  }
+  return outside;
+}
+
 }  // namespace
 
 // One node's change of velocity by a free body in one phase of one pass (CONTACT.md §3): the
@@ -275,8 +287,8 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
 // w_i = b_i / Σ b_j², so the point itself moves by δ n and its velocity by the response's
 // change. Triangles are found on the cells touching owned nodes, ghosts included, so each
 // node sums the pushes of its six triangles in one fixed order, whatever the decomposition.
-void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
-                        std::vector<Exchange>& out) {
+void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
+                        Field<Vec3>& next, std::vector<Exchange>& out) {
   const Block& b = *block_;
   const Solid& s = solids_[solid];
   const SolidGeometry& g = s.geometry;
@@ -310,8 +322,21 @@ void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
         const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
         const Closest c = g.closest(point);
         if (c.distance >= offset) continue;
+        double depth = offset - c.distance;
+        Vec3 side = c.normal;
+        // A thin solid can pass through a cell in one step, from one side to the other: the
+        // side the cell was on at the start of the step decides where it goes back to.
+        std::array<Vec3, 3> p0;
+        for (int v = 0; v < 3; ++v) p0[v] = s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
+        const std::array<double, 3> w0 = g.deepest_point(p0[0], p0[1], p0[2]);
+        const Closest c0 = g.closest(w0[0] * p0[0] + w0[1] * p0[1] + w0[2] * p0[2]);
+        const Vec3 before = s.proposed.pose.to_local_direction(s.state.pose.direction_to_world(c0.normal));
+        if (c0.distance >= 0.0 && dot(before, c.normal) < 0.0) {
+          side = before;
+          depth = clearance(g, point, side, offset);
+        }
         const double squares = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-        const Vec3 normal = s.proposed.pose.direction_to_world(c.normal);
+        const Vec3 normal = s.proposed.pose.direction_to_world(side);
         Vec3 velocity;
         for (int v = 0; v < 3; ++v) velocity += w[v] * velocity_(nodes[v][0], nodes[v][1]);
         CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(tri)];
@@ -319,7 +344,7 @@ void Contact::cell_pass(int pass, std::size_t solid, Field<Vec3>& next,
         push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
         push.velocity_change =
             velocity_change(s, s.proposed.pose.to_world(point), normal, velocity);
-        push.move = (offset - c.distance) * normal + slip_correction(push.velocity_change, normal);
+        push.move = depth * normal + slip_correction(push.velocity_change, normal);
       }
   // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
   struct Around {
@@ -401,7 +426,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     node_pass(pass, current, next, exchanges);
     for (std::size_t i = 0; i < solids_.size(); ++i)
-      if (std::isfinite(solids_[i].geometry.bounding_radius())) cell_pass(pass, i, next, exchanges);
+      if (std::isfinite(solids_[i].geometry.bounding_radius())) cell_pass(pass, i, current, next, exchanges);
     double penetration = 0.0;
     const bool inside = any_inside(next, penetration);
     stats.max_penetration = penetration;

@@ -86,7 +86,8 @@ class Contact {
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
   void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                  std::vector<Exchange>& out);
-  void cell_pass(int pass, std::size_t solid, Field<Vec3>& next, std::vector<Exchange>& out);
+  void cell_pass(int pass, std::size_t solid, const Field<Vec3>& current, Field<Vec3>& next,
+                 std::vector<Exchange>& out);
   // Whether an owned node still sits inside a solid's offset layer (any rank); the deepest
   // any owned node sits inside a solid itself goes to `penetration`.
   bool any_inside(const Field<Vec3>& next, double& penetration) const;

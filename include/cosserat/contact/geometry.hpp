@@ -39,6 +39,9 @@ struct Pose {
     return rotate(conjugate(orientation), world - position);
   }
   Vec3 direction_to_world(const Vec3& local) const { return rotate(orientation, local); }
+  Vec3 to_local_direction(const Vec3& world) const {
+    return rotate(conjugate(orientation), world);
+  }
 };
 
 struct TriangleMesh {
