@@ -38,6 +38,11 @@ OVERRIDES = ["grid.nodes=[24,24]", "time.steps=3000", "time.output_every=25"]
 # window in seconds (a window in steps is refused there), frames every 0.025 s.
 ADAPTIVE_OVERRIDES = ["grid.nodes=[24,24]", "time={duration=3.0, output_dt=0.025}",
                       "fix=[{nodes=[[0,0],[0,9]]}]"]
+# --contact: the cube thrown into a net (scenes/contact/cube_net_25.toml), a free body in
+# contact from step 450 on, for its first 0.6 s (3000 steps of 0.2 ms), frames every 0.01 s;
+# the solids' datasets are compared too.
+CONTACT_SCENE = os.path.join(REPO, "scenes", "contact", "cube_net_25.toml")
+CONTACT_OVERRIDES = ["time.duration=0.6"]
 CHECKPOINT_EVERY = 330
 SEGMENT_TIMEOUT = 300  # seconds; a segment still running then has hung
 MODES = ("random", "checkpoint", "frame")
@@ -70,7 +75,11 @@ def ranks_of(mpirun_pid):
 
 def datasets(path):
     with h5py.File(path, "r") as f:
-        return {name: f[name][()].tobytes() for name in ("/positions", "/time", "/step")}
+        names = ["/positions", "/time", "/step"]
+        if "solids" in f:
+            names += [f"/solids/{i}/{d}" for i in f["solids"]
+                      for d in ("position", "orientation", "world_vertices")]
+        return {name: f[name][()].tobytes() for name in names}
 
 
 def xdmf_frames(path):
@@ -176,9 +185,15 @@ def main():
     parser.add_argument("--keep", action="store_true", help="keep the trial folders")
     parser.add_argument("--adaptive", action="store_true",
                         help="adaptive steps instead of the fixed step")
+    parser.add_argument("--contact", action="store_true",
+                        help="the cube thrown into a net: contact with a free body")
     args = parser.parse_args()
+    global SCENE
     if args.adaptive:
         OVERRIDES[:] = ADAPTIVE_OVERRIDES
+    if args.contact:
+        SCENE = CONTACT_SCENE
+        OVERRIDES[:] = CONTACT_OVERRIDES
     rng = random.Random(args.seed)
     work = tempfile.mkdtemp(prefix="cosserat_stress_")
 
@@ -228,7 +243,7 @@ def main():
         f"Machine: {cpu}, {os.cpu_count()} cores, host {host}; compiler: {compiler}, -O3; "
         f"{mpi}; git {revision}{' (with uncommitted changes)' if dirty else ''}; seed {args.seed}.",
         "",
-        f"Scene: `scenes/s1_clothesline.toml` with `{' '.join('--set ' + o for o in OVERRIDES)}`, "
+        f"Scene: `{os.path.relpath(SCENE, REPO)}` with `{' '.join('--set ' + o for o in OVERRIDES)}`, "
         f"`--checkpoint-every {CHECKPOINT_EVERY}`, one OpenMP thread per rank; the uninterrupted "
         f"reference runs took {duration[1]:.1f}, {duration[2]:.1f} and {duration[3]:.1f} s on "
         "1, 2 and 3 ranks (and agree bitwise). "
@@ -239,10 +254,11 @@ def main():
         "(then), `checkpoint` (as soon as after that the checkpoint's `.partial` file is seen: "
         "mid-checkpoint), `frame` (as soon as after that the HDF5 file is seen to grow: inside a "
         "frame's write, flush and XDMF append). The output must equal the reference's "
-        "/positions, /time and /step byte for byte, and its XDMF file must parse and name every "
-        "frame.", "",
+        "/positions, /time and /step (and each solid's position, orientation and placed surface) "
+        "byte for byte, and its XDMF file must parse and name every frame.", "",
         "`benchmarks/run_stress_restart.py --trials "
-        f"{args.trials} --seed {args.seed}{' --adaptive' if args.adaptive else ''}`", "",
+        f"{args.trials} --seed {args.seed}{' --adaptive' if args.adaptive else ''}"
+        f"{' --contact' if args.contact else ''}`", "",
         "| trials | kills | random | mid-checkpoint | mid-frame | identical | failures |",
         "|---|---|---|---|---|---|---|",
         f"| {tally['trials']} | {tally['kills']} | {kinds['random']} | {kinds['checkpoint']} | "
@@ -252,7 +268,8 @@ def main():
         "killed rank's signal).", "",
         "| trial | segments | result |", "|---|---|---|"]
     lines += [f"| {i} | {s} | {r} |" for i, s, r in rows]
-    kind = "stress-restart-adaptive" if args.adaptive else "stress-restart"
+    kind = ("stress-restart-contact" if args.contact
+            else "stress-restart-adaptive" if args.adaptive else "stress-restart")
     stem = os.path.join(REPO, "benchmarks", "results", f"{kind}-{host}-{date}")
     with open(stem + ".md", "w") as f:
         f.write("\n".join(lines) + "\n")

@@ -613,7 +613,8 @@ RunSummary example_summary() {
   return summary;
 }
 
-// DESIGN.md's keys, in its order, with the decomposition and halo time of issue 3 added.
+// DESIGN.md's keys, in its order, with the decomposition and halo time of issue 3 added, and
+// the contact figures (null and empty without solids).
 TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
   const std::string json = to_json(example_summary());
   const std::regex key(R"re(\n  "(\w+)":)re");
@@ -629,10 +630,13 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
       "restarted_from", "status",
       "unstable_step", "area_ratio",    "max_speed",      "kinetic_energy",
       "elastic_energy", "gravitational_energy",
-      "center_of_mass", "output",        "linear_solves",  "rest",          "adaptive"};
+      "center_of_mass", "output",        "linear_solves",  "rest",          "adaptive",
+      "max_penetration", "max_contacts", "solids"};
   EXPECT_EQ(keys, expected);
+  EXPECT_NE(json.find(R"("max_penetration": null,)"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("solids": [])"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("linear_solves": null,)"), std::string::npos) << json;
-  EXPECT_NE(json.find(R"("adaptive": null)"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("adaptive": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("grid": [32, 48])"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("restarted_from": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("dt": 0.0001,)"), std::string::npos) << json;
@@ -652,6 +656,27 @@ TEST(RunSummaryTest, WritesLinearSolvesAndRest) {
   EXPECT_NE(json.find(R"("rest": {"fraction": 1e-06, "peak_kinetic_energy": 2, "step": 840})"),
             std::string::npos)
       << json;
+}
+
+// With solids: the run's contact figures and each solid's final state.
+TEST(RunSummaryTest, WritesContactFiguresAndEachSolidsState) {
+  RunSummary summary = example_summary();
+  summary.contact = ContactSummary{2.5e-4, 120};
+  SolidState cube;
+  cube.pose = {{1.0, 2.0, 3.0}, {0.5, 0.5, 0.5, 0.5}};
+  cube.velocity = {0.0, -1.5, 0.0};
+  cube.angular_velocity = {0.0, 0.0, 2.0};
+  summary.solids.push_back({"cube", "free", cube});
+  summary.solids.push_back({"floor", "fixed", SolidState{}});
+  const std::string json = to_json(summary);
+  EXPECT_NE(json.find(R"("max_penetration": 0.00025,)"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"("max_contacts": 120,)"), std::string::npos) << json;
+  EXPECT_NE(json.find(R"({"name": "cube", "motion": "free", "position": [1, 2, 3], )"
+                      R"("orientation": [0.5, 0.5, 0.5, 0.5], "velocity": [0, -1.5, 0], )"
+                      R"("angular_velocity": [0, 0, 2]},)"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find(R"({"name": "floor", "motion": "fixed")"), std::string::npos) << json;
 }
 
 TEST(RunSummaryTest, WritesNullForMissingAndNonFiniteValues) {
