@@ -20,7 +20,7 @@ build/benchmark/benchmarks/bench_contact --benchmark_min_time=2 --benchmark_repe
 import json, sys
 stem, cpu, compiler, revision, date = sys.argv[1:]
 runs = [b for b in json.load(open(stem + ".json"))["benchmarks"] if b.get("aggregate_name") == "median"]
-names = {0: "no solid", 1: "one plane (every node in contact)", 2: "one sphere", 3: "ten solids"}
+names = {0: "no solid", 1: "one plane (every node in contact)", 2: "one sphere (radius 5 m)", 3: "ten solids"}
 rows = {}
 for b in runs:
     fields = dict(part.split(":") for part in b["name"].split("/")[1:] if ":" in part)

@@ -136,7 +136,7 @@ struct Contact::Exchange {
 // A cell triangle pressed into a solid: its barycentric weights at the deepest point, the move
 // δ n of that point and the change of its velocity (CONTACT.md §2, "Between nodes").
 struct Contact::CellPush {
-  bool active = false;
+  std::size_t triangle = 0;  // its index among the block's: 2 (cell index) + 0 or 1
   std::array<double, 3> weights{};
   Vec3 move;
   Vec3 velocity_change;
@@ -150,7 +150,8 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
       gravity_(gravity),
       spacing_(spacing),
       velocity_(block),
-      touched_(block) {
+      touched_(block),
+      distance_(block) {
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false};
     if (spec.motion == SolidMotion::free) {
@@ -249,17 +250,18 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
         const SolidGeometry& g = s.geometry;
         const double offset = s.spec.thickness;
         const Vec3 end = s.proposed.pose.to_local(next(k, l));
+        const Vec3 start = s.state.pose.to_local(current(k, l));
+        const Vec3 path = end - start;
+        // A segment that stays outside the ball holding a bounded solid cannot touch it.
+        if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
         const Closest at_end = g.closest(end);
         Vec3 target, normal;
         if (at_end.distance < offset) {
           normal = at_end.normal;
           target = end + (offset - at_end.distance) * normal;
         } else {
-          // Both ends outside: only a segment passing near a bounded solid can cross it.
+          // Both ends outside: only a segment crossing a bounded solid can touch it.
           if (s.spec.shape.kind == ShapeKind::plane) continue;
-          const Vec3 start = s.state.pose.to_local(current(k, l));
-          const Vec3 path = end - start;
-          if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
           if (g.closest(start).distance < offset) continue;  // leaving, not entering
           const std::optional<double> t = g.first_contact(start, end, offset);
           if (!t) continue;
@@ -293,31 +295,49 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const Solid& s = solids_[solid];
   const SolidGeometry& g = s.geometry;
   const double offset = s.spec.thickness;
-  const double reach = g.bounding_radius() + offset;
+  const double radius = g.bounding_radius();
   const double round_off = 1e-9 * (offset + spacing_);
   halo_->exchange(next);
   halo_->exchange(velocity_);
-  // Cells (kc, lc), kc in [k0 − 1, k1), lc in [l0 − 1, l1), those inside the grid.
-  const int width = b.owned_k() + 1;
-  const auto cell = [&](int kc, int lc) {
-    return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * 2;
-  };
-  cells_.assign(static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2, CellPush{});
+  // Cells (kc, lc), kc in [k0 − 1, k1), lc in [l0 − 1, l1), those inside the grid; their nodes
+  // are [k0 − 1, k1] x [l0 − 1, l1].
+  const int kc0 = std::max(b.k0 - 1, 0), kc1 = std::min(b.k1, b.m - 1);
+  const int lc0 = std::max(b.l0 - 1, 0), lc1 = std::min(b.l1, b.n - 1);
+  // A lower bound of each node's signed distance: the distance itself near the solid, the
+  // distance to its bounding ball farther out. The distance is 1-Lipschitz, so a triangle
+  // whose nodes are all farther than its longest edge plus the offset cannot be pressed in.
 #pragma omp parallel for schedule(static)
-  for (int lc = std::max(b.l0 - 1, 0); lc < std::min(b.l1, b.n - 1); ++lc)
-    for (int kc = std::max(b.k0 - 1, 0); kc < std::min(b.k1, b.m - 1); ++kc)
+  for (int l = lc0; l <= lc1; ++l)
+    for (int k = kc0; k <= kc1; ++k) {
+      const Vec3 p = s.proposed.pose.to_local(next(k, l));
+      const double outside_ball = norm(p) - radius;
+      distance_(k, l) = outside_ball > offset ? outside_ball : g.closest(p).distance;
+    }
+  const int width = b.owned_k() + 1;
+  const auto triangle = [&](int kc, int lc, int tri) {
+    return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * 2 +
+           static_cast<std::size_t>(tri);
+  };
+  if (slot_.size() != static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2)
+    slot_.assign(static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2, -1);
+  std::vector<std::vector<CellPush>> rows(static_cast<std::size_t>(std::max(lc1 - lc0, 0)));
+#pragma omp parallel for schedule(static)
+  for (int lc = lc0; lc < lc1; ++lc)
+    for (int kc = kc0; kc < kc1; ++kc)
       for (int tri = 0; tri < 2; ++tri) {
+        // Corners of the two triangles, ordered so that the grid's mirror (k, l) → (l, k)
+        // maps one triangle onto the other with its corners in the same order.
         const std::array<std::array<int, 2>, 3> nodes =
             tri == 0 ? std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}}
-                     : std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc + 1, lc + 1}, {kc, lc + 1}}};
+                     : std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
         std::array<Vec3, 3> p;
         double nearest = 1e300, longest = 0.0;
         for (int v = 0; v < 3; ++v) {
           p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
-          nearest = std::min(nearest, norm(p[v]));
+          nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
         }
         for (int v = 0; v < 3; ++v) longest = std::max(longest, norm(p[(v + 1) % 3] - p[v]));
-        if (nearest - longest > reach) continue;
+        if (nearest - longest >= offset) continue;
         const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
         if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
         const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
@@ -331,10 +351,12 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         // A thin solid can pass through a cell in one step, from one side to the other: the
         // side the cell was on at the start of the step decides where it goes back to.
         std::array<Vec3, 3> p0;
-        for (int v = 0; v < 3; ++v) p0[v] = s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
+        for (int v = 0; v < 3; ++v)
+          p0[v] = s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
         const std::array<double, 3> w0 = g.deepest_point(p0[0], p0[1], p0[2]);
         const Closest c0 = g.closest(w0[0] * p0[0] + w0[1] * p0[1] + w0[2] * p0[2]);
-        const Vec3 before = s.proposed.pose.to_local_direction(s.state.pose.direction_to_world(c0.normal));
+        const Vec3 before =
+            s.proposed.pose.to_local_direction(s.state.pose.direction_to_world(c0.normal));
         if (c0.distance >= 0.0 && dot(before, c.normal) < 0.0) {
           side = before;
           depth = clearance(g, point, side, offset);
@@ -343,20 +365,25 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         const Vec3 normal = s.proposed.pose.direction_to_world(side);
         Vec3 velocity;
         for (int v = 0; v < 3; ++v) velocity += w[v] * velocity_(nodes[v][0], nodes[v][1]);
-        CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(tri)];
-        push.active = true;
+        CellPush push;
+        push.triangle = triangle(kc, lc, tri);
         push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
         push.velocity_change =
             velocity_change(s, s.proposed.pose.to_world(point), normal, velocity);
         push.move = depth * normal + slip_correction(push.velocity_change, normal);
+        rows[static_cast<std::size_t>(lc - lc0)].push_back(push);
       }
+  cells_.clear();
+  for (const auto& row : rows) cells_.insert(cells_.end(), row.begin(), row.end());
+  if (cells_.empty()) return;
+  for (std::size_t i = 0; i < cells_.size(); ++i) slot_[cells_[i].triangle] = static_cast<int>(i);
   // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
   struct Around {
     int dk, dl, tri, corner;
   };
   static constexpr std::array<Around, 6> around{
-      {{0, 0, 0, 0}, {0, 0, 1, 0}, {-1, 0, 0, 1}, {-1, -1, 0, 2}, {-1, -1, 1, 1}, {0, -1, 1, 2}}};
-  std::vector<std::vector<Exchange>> rows(static_cast<std::size_t>(b.owned_l()));
+      {{0, 0, 0, 0}, {0, 0, 1, 0}, {-1, 0, 0, 1}, {-1, -1, 0, 2}, {-1, -1, 1, 2}, {0, -1, 1, 1}}};
+  std::vector<std::vector<Exchange>> exchange_rows(static_cast<std::size_t>(b.owned_l()));
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k) {
@@ -365,8 +392,9 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       for (const Around& a : around) {
         const int kc = k + a.dk, lc = l + a.dl;
         if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
-        const CellPush& push = cells_[cell(kc, lc) + static_cast<std::size_t>(a.tri)];
-        if (!push.active) continue;
+        const int slot = slot_[triangle(kc, lc, a.tri)];
+        if (slot < 0) continue;
+        const CellPush& push = cells_[static_cast<std::size_t>(slot)];
         const double weight = push.weights[static_cast<std::size_t>(a.corner)];
         move += weight * push.move;
         dv += weight * push.velocity_change;
@@ -379,9 +407,11 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       r += move;
       velocity_(k, l) += dv;
       touched_(k, l) = 1;
-      record(solid, pass, 1, k, l, r_before, v_before, r, rows[static_cast<std::size_t>(l - b.l0)]);
+      record(solid, pass, 1, k, l, r_before, v_before, r,
+             exchange_rows[static_cast<std::size_t>(l - b.l0)]);
     }
-  for (const auto& row : rows) out.insert(out.end(), row.begin(), row.end());
+  for (const CellPush& push : cells_) slot_[push.triangle] = -1;
+  for (const auto& row : exchange_rows) out.insert(out.end(), row.begin(), row.end());
 }
 
 bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {

@@ -103,7 +103,9 @@ class Contact {
   bool any_free_ = false;
   Field<Vec3> velocity_;           // the nodes' velocities during a response
   Field<unsigned char> touched_;   // nodes the response changed
-  std::vector<CellPush> cells_;    // cell_pass's triangles
+  Field<double> distance_;         // cell_pass: a lower bound of each node's signed distance
+  std::vector<CellPush> cells_;    // cell_pass: the triangles pressed in
+  std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
 };
 
 }  // namespace cosserat
