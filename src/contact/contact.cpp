@@ -110,6 +110,12 @@ Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double 
 }
 
 
+// The angle a frame turns through from orientation a to b.
+double turn_angle(const Quaternion& a, const Quaternion& b) {
+  const double c = std::min(1.0, std::abs(a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z));
+  return 2.0 * std::acos(c);
+}
+
 // How far along unit direction n point p (in the shape's frame) must move to be `offset` clear
 // of the shape: bisection on the signed distance, from a bound where the ball holding the shape
 // is left behind.
@@ -249,10 +255,20 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
         const Solid& s = solids_[i];
         const SolidGeometry& g = s.geometry;
         const double offset = s.spec.thickness;
-        const Vec3 end = s.proposed.pose.to_local(next(k, l));
+        // A segment that stays outside the ball holding a bounded solid cannot touch it: first
+        // in world coordinates, then in the solid's frame.
+        // The path in the frame is at most the node's own, plus the frame's shift, plus its
+        // turn times the node's distance from the frame's origin (a chord is shorter than its
+        // arc).
+        const Vec3 world_end = next(k, l);
+        const Vec3 world_start = current(k, l);
+        const double path_bound = norm(world_end - world_start) + shift_[i] +
+                                  turn_[i] * norm(world_start - s.state.pose.position);
+        if (norm(world_end - s.proposed.pose.position) - path_bound > g.bounding_radius() + offset)
+          continue;
+        const Vec3 end = s.proposed.pose.to_local(world_end);
         const Vec3 start = s.state.pose.to_local(current(k, l));
         const Vec3 path = end - start;
-        // A segment that stays outside the ball holding a bounded solid cannot touch it.
         if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
         const Closest at_end = g.closest(end);
         Vec3 target, normal;
@@ -309,9 +325,10 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
 #pragma omp parallel for schedule(static)
   for (int l = lc0; l <= lc1; ++l)
     for (int k = kc0; k <= kc1; ++k) {
-      const Vec3 p = s.proposed.pose.to_local(next(k, l));
-      const double outside_ball = norm(p) - radius;
-      distance_(k, l) = outside_ball > offset ? outside_ball : g.closest(p).distance;
+      const double outside_ball = norm(next(k, l) - s.proposed.pose.position) - radius;
+      distance_(k, l) = outside_ball > offset
+                            ? outside_ball
+                            : g.closest(s.proposed.pose.to_local(next(k, l))).distance;
     }
   const int width = b.owned_k() + 1;
   const auto triangle = [&](int kc, int lc, int tri) {
@@ -330,14 +347,16 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         const std::array<std::array<int, 2>, 3> nodes =
             tri == 0 ? std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}}
                      : std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
-        std::array<Vec3, 3> p;
         double nearest = 1e300, longest = 0.0;
         for (int v = 0; v < 3; ++v) {
-          p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
           nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
+          const auto& a = nodes[v];
+          const auto& b2 = nodes[(v + 1) % 3];
+          longest = std::max(longest, norm(next(b2[0], b2[1]) - next(a[0], a[1])));
         }
-        for (int v = 0; v < 3; ++v) longest = std::max(longest, norm(p[(v + 1) % 3] - p[v]));
         if (nearest - longest >= offset) continue;
+        std::array<Vec3, 3> p;
+        for (int v = 0; v < 3; ++v) p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
         const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
         if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
         const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
@@ -422,9 +441,10 @@ bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k)
       for (const Solid& s : solids_) {
-        const Vec3 p = s.proposed.pose.to_local(next(k, l));
         const double offset = s.spec.thickness;
-        if (norm(p) > s.geometry.bounding_radius() + offset) continue;
+        if (norm(next(k, l) - s.proposed.pose.position) > s.geometry.bounding_radius() + offset)
+          continue;
+        const Vec3 p = s.proposed.pose.to_local(next(k, l));
         const double d = s.geometry.closest(p).distance;
         deepest = std::max(deepest, -d);
         // Round-off of the projection onto the offset surface is not inside.
@@ -441,11 +461,16 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
                               std::vector<NodeVelocity>& corrected) {
   const Block& b = *block_;
   dt_ = dt;
-  for (Solid& s : solids_) {
+  shift_.assign(solids_.size(), 0.0);
+  turn_.assign(solids_.size(), 0.0);
+  for (std::size_t i = 0; i < solids_.size(); ++i) {
+    Solid& s = solids_[i];
     if (s.spec.motion == SolidMotion::free)
       propose_free(s, dt);
     else if (s.spec.motion == SolidMotion::kinematic)
       s.proposed = kinematic_state(s.spec, time + dt);
+    shift_[i] = norm(s.proposed.pose.position - s.state.pose.position);
+    turn_[i] = turn_angle(s.state.pose.orientation, s.proposed.pose.orientation);
   }
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)

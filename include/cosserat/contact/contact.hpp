@@ -99,7 +99,9 @@ class Contact {
   double node_mass_;
   Vec3 gravity_;
   double spacing_;
-  double dt_ = 0.0;  // of the step being proposed
+  double dt_ = 0.0;           // of the step being proposed
+  std::vector<double> shift_;  // node_pass: each solid's frame's move over the step (m)
+  std::vector<double> turn_;   // and its turn (rad)
   bool any_free_ = false;
   Field<Vec3> velocity_;           // the nodes' velocities during a response
   Field<unsigned char> touched_;   // nodes the response changed
