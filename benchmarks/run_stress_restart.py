@@ -83,8 +83,10 @@ def datasets(path):
 
 
 def xdmf_frames(path):
+    """The entries of the temporal collection: one per frame (the cloth alone, or the cloth and
+    the solids in a spatial collection)."""
     root = xml.parse(path).getroot()
-    return len(root.findall(".//Grid[@GridType='Uniform']"))
+    return len(root.findall("./Domain/Grid[@CollectionType='Temporal']/Grid"))
 
 
 def run_segment(cosserat, ranks, output, restart, mode, duration, rng, log):
