@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <string>
 #include <limits>
 #include <vector>
 
@@ -307,6 +309,113 @@ TEST(Contact, ACubeThrownIntoANetStaysInItsPlaneOfSymmetryThroughTheImpact) {
               std::hypot(top.x, top.z));
   EXPECT_GT(top.y, lowest + 0.1);
   EXPECT_LT(off_plane_at_impact, 1e-12);
+}
+
+// A kinematic solid follows its path, a closed function of time, whatever the steps: keyframes
+// linear in position and spherical-linear in orientation, held outside them; a constant
+// velocity between start_time and end_time.
+TEST(Contact, KinematicSolidsFollowTheirPaths) {
+  const Scene scene = parse_scene(R"(
+[grid]
+nodes = [4, 4]
+size = [1.0, 1.0]
+[material]
+mass = 0.2
+zeta = 10.0
+xi = 0.001
+phi = 0.0
+[time]
+dt = 0.01
+steps = 60
+[[solid]]
+shape = "box"
+center = [0.0, 5.0, 0.0]
+half_extents = [0.1, 0.1, 0.1]
+motion = "kinematic"
+keyframes = [ { time = 0.1, position = [0.0, 5.0, 0.0] },
+              { time = 0.3, position = [1.0, 5.0, 0.0], orientation = { axis = [0, 1, 0], angle = 1.0 } } ]
+[[solid]]
+shape = "sphere"
+center = [0.0, -5.0, 0.0]
+radius = 0.1
+motion = "kinematic"
+velocity = [0.0, 0.0, 2.0]
+angular_velocity = [0.0, 3.0, 0.0]
+start_time = 0.2
+end_time = 0.4
+)",
+                                   "paths.toml");
+  Simulation sim(scene, MPI_COMM_SELF);
+  const Contact& contact = *sim.contact();
+  const auto at = [&](double t) {
+    while (sim.time() < t - 1e-9) EXPECT_FALSE(sim.step());
+  };
+  at(0.05);
+  EXPECT_NEAR(contact.state(0).pose.position.x, 0.0, 1e-15);
+  at(0.2);
+  EXPECT_NEAR(contact.state(0).pose.position.x, 0.5, 1e-12);
+  EXPECT_NEAR(contact.state(0).velocity.x, 5.0, 1e-9);
+  // Halfway between the identity and 1 rad about y: 0.5 rad.
+  const Quaternion q = contact.state(0).pose.orientation;
+  EXPECT_NEAR(2.0 * std::atan2(q.y, q.w), 0.5, 1e-12);
+  EXPECT_NEAR(contact.state(1).pose.position.z, 0.0, 1e-15);
+  at(0.3);
+  EXPECT_NEAR(contact.state(1).pose.position.z, 0.2, 1e-12);
+  at(0.5);
+  EXPECT_NEAR(contact.state(0).pose.position.x, 1.0, 1e-15);
+  EXPECT_NEAR(contact.state(1).pose.position.z, 0.4, 1e-12);
+  EXPECT_EQ(norm(contact.state(1).velocity), 0.0);
+  const Quaternion r = contact.state(1).pose.orientation;
+  EXPECT_NEAR(2.0 * std::atan2(r.y, r.w), 0.6, 1e-12);
+}
+
+// A closed triangle mesh from an OBJ file holds the cloth as the solid it bounds: a sheet
+// falling onto a mesh cube ends no step inside it and comes to rest on its top.
+TEST(Contact, AMeshSolidHoldsTheSheet) {
+  const std::string folder = ::testing::TempDir();
+  {
+    std::ofstream obj(folder + "/contact_cube.obj");
+    obj << "v -0.3 -0.3 -0.3\nv 0.3 -0.3 -0.3\nv 0.3 0.3 -0.3\nv -0.3 0.3 -0.3\n"
+           "v -0.3 -0.3 0.3\nv 0.3 -0.3 0.3\nv 0.3 0.3 0.3\nv -0.3 0.3 0.3\n"
+           "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\n"
+           "f 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n";
+  }
+  const Scene scene = parse_scene(R"(
+[grid]
+nodes = [7, 7]
+size = [1.0, 1.0]
+origin = [-0.5, 0.35, -0.5]
+[material]
+mass = 0.2
+zeta = 20.0
+xi = 0.001
+phi = 0.0
+[environment]
+gravity = [0.0, -9.81, 0.0]
+damping = 0.5
+[time]
+dt = 5e-4
+steps = 600
+[[solid]]
+shape = "mesh"
+file = "contact_cube.obj"
+thickness = 0.002
+)",
+                                   folder + "/mesh_scene.toml");
+  Simulation sim(scene, MPI_COMM_SELF);
+  for (long i = 0; i < scene.steps; ++i) {
+    ASSERT_FALSE(sim.step()) << "step " << i;
+    const Block& b = sim.block();
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k) {
+        const Vec3 p = sim.positions()(k, l);
+        const double inside = std::min({0.3 - std::abs(p.x), 0.3 - std::abs(p.y), 0.3 - std::abs(p.z)});
+        ASSERT_LE(inside, 1e-9) << k << ", " << l << " step " << i;
+      }
+  }
+  // The middle node rests on the top face, the thickness above it.
+  EXPECT_NEAR(sim.positions()(3, 3).y, 0.302, 1e-3);
+  EXPECT_GT(sim.contact_summary().max_contacts, 0);
 }
 
 // Every scheme keeps every node out of a solid: a sheet falling onto a sphere under gravity.
