@@ -367,8 +367,10 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         if (c.distance >= offset - round_off) continue;
         double depth = offset - c.distance;
         Vec3 side = c.normal;
-        // A thin solid can pass through a cell in one step, from one side to the other: the
-        // side the cell was on at the start of the step decides where it goes back to.
+        // A thin solid can pass through a cell in one step, from one side to the other, or
+        // end the step with the cell across its core, where the nearest surface can be any
+        // way: when the normal turned by more than 60° from the side the cell was on at the
+        // start of the step, that side decides where it goes back to.
         std::array<Vec3, 3> p0;
         for (int v = 0; v < 3; ++v)
           p0[v] = s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
@@ -376,7 +378,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         const Closest c0 = g.closest(w0[0] * p0[0] + w0[1] * p0[1] + w0[2] * p0[2]);
         const Vec3 before =
             s.proposed.pose.to_local_direction(s.state.pose.direction_to_world(c0.normal));
-        if (c0.distance >= 0.0 && dot(before, c.normal) < 0.0) {
+        if (c0.distance >= 0.0 && dot(before, c.normal) < 0.5) {
           side = before;
           depth = clearance(g, point, side, offset);
         }
