@@ -367,20 +367,20 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         if (c.distance >= offset - round_off) continue;
         double depth = offset - c.distance;
         Vec3 side = c.normal;
-        // A thin solid can pass through a cell in one step, from one side to the other, or
-        // end the step with the cell across its core, where the nearest surface can be any
-        // way: when the normal turned by more than 60° from the side the cell was on at the
-        // start of the step, that side decides where it goes back to.
-        std::array<Vec3, 3> p0;
+        // The point's own path over the step, in the solid's frame at each end's time, says
+        // where it entered: a thin solid can pass through a cell in one step, or leave it
+        // across the solid's core, where the nearest surface can be any way. When the surface
+        // it entered through faces more than 60° away from the nearest one, it goes back out
+        // through the one it entered, as far as it takes to clear the solid.
+        Vec3 from;
         for (int v = 0; v < 3; ++v)
-          p0[v] = s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
-        const std::array<double, 3> w0 = g.deepest_point(p0[0], p0[1], p0[2]);
-        const Closest c0 = g.closest(w0[0] * p0[0] + w0[1] * p0[1] + w0[2] * p0[2]);
-        const Vec3 before =
-            s.proposed.pose.to_local_direction(s.state.pose.direction_to_world(c0.normal));
-        if (c0.distance >= 0.0 && dot(before, c.normal) < 0.5) {
-          side = before;
-          depth = clearance(g, point, side, offset);
+          from += w[v] * s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
+        if (const std::optional<double> t = g.first_contact(from, point, offset)) {
+          const Vec3 entered = g.closest(from + *t * (point - from)).normal;
+          if (dot(entered, c.normal) < 0.5) {
+            side = entered;
+            depth = clearance(g, point, side, offset);
+          }
         }
         const double squares = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
         const Vec3 normal = s.proposed.pose.direction_to_world(side);
