@@ -157,7 +157,8 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
       spacing_(spacing),
       velocity_(block),
       touched_(block),
-      distance_(block) {
+      distance_(block),
+      normal_(block) {
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false};
     if (spec.motion == SolidMotion::free) {
@@ -313,6 +314,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const double offset = s.spec.thickness;
   const double radius = g.bounding_radius();
   const double round_off = 1e-9 * (offset + spacing_);
+  const bool convex = s.spec.shape.kind != ShapeKind::mesh;
   halo_->exchange(next);
   halo_->exchange(velocity_);
   // Cells (kc, lc), kc in [k0 − 1, k1), lc in [l0 − 1, l1), those inside the grid; their nodes
@@ -326,9 +328,14 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   for (int l = lc0; l <= lc1; ++l)
     for (int k = kc0; k <= kc1; ++k) {
       const double outside_ball = norm(next(k, l) - s.proposed.pose.position) - radius;
-      distance_(k, l) = outside_ball > offset
-                            ? outside_ball
-                            : g.closest(s.proposed.pose.to_local(next(k, l))).distance;
+      if (outside_ball > offset) {
+        distance_(k, l) = outside_ball;
+        normal_(k, l) = {};
+      } else {
+        const Closest c = g.closest(s.proposed.pose.to_local(next(k, l)));
+        distance_(k, l) = c.distance;
+        normal_(k, l) = c.normal;
+      }
     }
   const int width = b.owned_k() + 1;
   const auto triangle = [&](int kc, int lc, int tri) {
@@ -357,6 +364,20 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         if (nearest - longest >= offset) continue;
         std::array<Vec3, 3> p;
         for (int v = 0; v < 3; ++v) p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
+        // The signed distance to a convex solid lies above its tangent plane at each node, so
+        // over the triangle it is at least d_v + min_j n_v·(p_j − p_v) for every node v: a
+        // cell resting on a face, all its nodes on the offset surface, is not tested further.
+        if (convex) {
+          double lower = -1e300;
+          for (int v = 0; v < 3; ++v) {
+            const Vec3 n = normal_(nodes[v][0], nodes[v][1]);
+            if (dot(n, n) == 0.0) continue;
+            double reach = 0.0;
+            for (int j = 0; j < 3; ++j) reach = std::min(reach, dot(n, p[j] - p[v]));
+            lower = std::max(lower, distance_(nodes[v][0], nodes[v][1]) + reach);
+          }
+          if (lower >= offset - round_off) continue;
+        }
         const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
         if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
         const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];

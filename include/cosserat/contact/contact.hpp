@@ -106,6 +106,7 @@ class Contact {
   Field<Vec3> velocity_;           // the nodes' velocities during a response
   Field<unsigned char> touched_;   // nodes the response changed
   Field<double> distance_;         // cell_pass: a lower bound of each node's signed distance
+  Field<Vec3> normal_;             // and the normal there (solid's frame), zero when far
   std::vector<CellPush> cells_;    // cell_pass: the triangles pressed in
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
 };
