@@ -48,19 +48,32 @@ constexpr std::string_view kTail = R"(    </Grid>
 // The extent is the dataset's when the frame was written, frame + 1 frames: XDMF 3 reads the
 // slab from the dataset as it is in the file (the extent only matters when XDMF writes), and a
 // frame's text that named the final count would have to be rewritten at every later frame.
-std::string frame_grid(const std::string& h5_file, int m, int n, std::size_t frame, double time) {
+//
+// The cloth's grid of one frame, named `name`, its lines indented by `indent` spaces; `time`
+// goes on its own line inside it (empty: the enclosing collection carries the time).
+std::string cloth_grid(const std::string& h5_file, int m, int n, std::size_t frame,
+                       const std::string& name, const std::string& time, std::size_t indent) {
+  const std::string pad(indent, ' ');
   return fmt::format(
-      R"(      <Grid Name="frame_{frame}" GridType="Uniform">
-        <Time Value="{time}"/>
-        <Topology TopologyType="2DSMesh" Dimensions="{m} {n}"/>
-        <Geometry GeometryType="XYZ">
-          <DataItem Dimensions="{m} {n} 3" NumberType="Float" Precision="8"
-                    Format="HDF">{file}:/positions|{frame} 0 0 0:1 1 1 1:1 {m} {n} 3:{extent} {m} {n} 3</DataItem>
-        </Geometry>
-      </Grid>
+      R"({pad}<Grid Name="{name}" GridType="Uniform">
+{time}{pad}  <Topology TopologyType="2DSMesh" Dimensions="{m} {n}"/>
+{pad}  <Geometry GeometryType="XYZ">
+{pad}    <DataItem Dimensions="{m} {n} 3" NumberType="Float" Precision="8"
+{pad}              Format="HDF">{file}:/positions|{frame} 0 0 0:1 1 1 1:1 {m} {n} 3:{extent} {m} {n} 3</DataItem>
+{pad}  </Geometry>
+{pad}</Grid>
 )",
-      fmt::arg("frame", frame), fmt::arg("extent", frame + 1), fmt::arg("time", time),
-      fmt::arg("m", m), fmt::arg("n", n), fmt::arg("file", h5_file));
+      fmt::arg("pad", pad), fmt::arg("name", name), fmt::arg("time", time),
+      fmt::arg("frame", frame), fmt::arg("extent", frame + 1), fmt::arg("m", m),
+      fmt::arg("n", n), fmt::arg("file", h5_file));
+}
+
+std::string time_line(double time, std::size_t indent) {
+  return fmt::format("{}<Time Value=\"{}\"/>\n", std::string(indent, ' '), time);
+}
+
+std::string frame_grid(const std::string& h5_file, int m, int n, std::size_t frame, double time) {
+  return cloth_grid(h5_file, m, n, frame, fmt::format("frame_{}", frame), time_line(time, 8), 6);
 }
 
 // With solids, a frame is a spatial collection: the cloth's grid as above (without its own time,
@@ -71,17 +84,9 @@ std::string frame_collection(const std::string& h5_file, int m, int n,
                              double time) {
   std::string grid = fmt::format(
       R"(      <Grid Name="frame_{frame}" GridType="Collection" CollectionType="Spatial">
-        <Time Value="{time}"/>
-        <Grid Name="cloth" GridType="Uniform">
-          <Topology TopologyType="2DSMesh" Dimensions="{m} {n}"/>
-          <Geometry GeometryType="XYZ">
-            <DataItem Dimensions="{m} {n} 3" NumberType="Float" Precision="8"
-                      Format="HDF">{file}:/positions|{frame} 0 0 0:1 1 1 1:1 {m} {n} 3:{extent} {m} {n} 3</DataItem>
-          </Geometry>
-        </Grid>
 )",
-      fmt::arg("frame", frame), fmt::arg("extent", frame + 1), fmt::arg("time", time),
-      fmt::arg("m", m), fmt::arg("n", n), fmt::arg("file", h5_file));
+      fmt::arg("frame", frame));
+  grid += time_line(time, 8) + cloth_grid(h5_file, m, n, frame, "cloth", "", 8);
   for (std::size_t i = 0; i < solids.size(); ++i) {
     const XdmfSolid& solid = solids[i];
     grid += fmt::format(
