@@ -14,6 +14,7 @@
 #include <mpi.h>
 #include <omp.h>
 
+#include "bench_sheet.hpp"
 #include "cosserat/time/simulation.hpp"
 
 namespace {
@@ -31,22 +32,8 @@ SolidSpec solid(ShapeKind kind, const Vec3& center) {
 }
 
 cosserat::Scene sheet(int nodes, int solids) {
-  cosserat::Scene s;
-  s.name = "bench";
-  s.m = s.n = nodes;
-  s.size1 = s.size2 = 10.0;
+  cosserat::Scene s = cosserat::bench::flat_sheet(nodes);
   s.origin = {-5.0, 1e-3, -5.0};
-  s.material.mass = 10.0;
-  s.material.zeta = {100.0, 100.0, 100.0};
-  s.material.xi = {0.3, 0.3, 0.3};
-  s.material.phi = {0.001, 0.001, 0.001};
-  s.gravity = {0.0, -9.8, 0.0};
-  s.damping = 0.2;
-  s.integrator = cosserat::Integrator::verlet;
-  const double h = s.size1 / (nodes - 1);
-  s.dt = 0.02 * h * h;  // as bench_step
-  s.steps = 1;
-  s.output_every = 1;
   SolidSpec plane = solid(ShapeKind::plane, {});
   plane.pose.orientation = cosserat::rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
   if (solids == 1 || solids == 3) s.solids.push_back(plane);
@@ -108,12 +95,3 @@ BENCHMARK(contact_step)
     ->MinTime(2.0);
 
 }  // namespace
-
-int main(int argc, char** argv) {
-  MPI_Init(&argc, &argv);
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  MPI_Finalize();
-  return 0;
-}

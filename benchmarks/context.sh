@@ -1,6 +1,7 @@
 # Sourced by the benchmark scripts: builds TARGET with PRESET and sets what every result file
 # records beside its numbers (date, host, cpu, compiler, git revision) and the stem
-# benchmarks/results/NAME-<host>-<date> of the result files. Runs from the repository root.
+# benchmarks/results/NAME-<host>-<date> of the result files; defines run_step_benchmark. Runs
+# from the repository root.
 #   source benchmarks/context.sh NAME PRESET TARGET
 # CONTEXT_BUILD=0 skips the build (a script given a prebuilt binary, e.g. run_parity.sh).
 if [ "${CONTEXT_BUILD:-1}" != 0 ]; then
@@ -14,3 +15,17 @@ stem=benchmarks/results/$1-$host-$date
 cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
 compiler=$(c++ --version | head -1)
 revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+
+# Runs one of the step benchmarks on one rank (OMP_PROC_BIND=close), median of 3 repetitions of
+# at least 2 s each, with the context above in its JSON output, $stem.json.
+#   run_step_benchmark BINARY [extra Google Benchmark flags]
+run_step_benchmark() {
+  local binary=$1
+  shift
+  OMP_PROC_BIND=close "$binary" --benchmark_min_time=2 --benchmark_repetitions=3 \
+    --benchmark_report_aggregates_only=true \
+    --benchmark_context=cpu="$cpu" --benchmark_context=compiler="$compiler" \
+    --benchmark_context=flags="-O3 -march=native" --benchmark_context=git="$revision" \
+    --benchmark_context=ranks=1 \
+    --benchmark_out="$stem.json" --benchmark_out_format=json "$@"
+}

@@ -7,14 +7,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source benchmarks/context.sh contact benchmark bench_contact
-export OMP_PROC_BIND=close
 
-build/benchmark/benchmarks/bench_contact --benchmark_min_time=2 --benchmark_repetitions=3 \
-  --benchmark_report_aggregates_only=true \
-  --benchmark_context=cpu="$cpu" --benchmark_context=compiler="$compiler" \
-  --benchmark_context=flags="-O3 -march=native" --benchmark_context=git="$revision" \
-  --benchmark_context=ranks=1 \
-  --benchmark_out="$stem.json" --benchmark_out_format=json "$@"
+run_step_benchmark build/benchmark/benchmarks/bench_contact "$@"
 
 /usr/bin/python3 - "$stem" "$cpu" "$compiler" "$revision" "$date" <<'PY'
 import json, sys
