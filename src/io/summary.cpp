@@ -81,10 +81,9 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   summary.adaptive = loop.adaptive;
   if (const Contact* contact = simulation.contact()) {
     summary.contact = simulation.contact_summary();
-    static constexpr const char* motions[] = {"fixed", "kinematic", "free"};
     for (std::size_t i = 0; i < contact->size(); ++i)
       summary.solids.push_back({contact->spec(i).name,
-                                motions[static_cast<int>(contact->spec(i).motion)],
+                                std::string(solid_motion_name(contact->spec(i).motion)),
                                 contact->state(i)});
   }
   return summary;

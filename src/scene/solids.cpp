@@ -37,9 +37,10 @@ const std::array<KeysOf, 6> kShapes{{
 
 // In SolidMotion order.
 const std::array<KeysOf, 3> kMotions{{
-    {"fixed", {}},
-    {"kinematic", {"velocity", "angular_velocity", "start_time", "end_time", "keyframes"}},
-    {"free",
+    {solid_motion_name(SolidMotion::fixed), {}},
+    {solid_motion_name(SolidMotion::kinematic),
+     {"velocity", "angular_velocity", "start_time", "end_time", "keyframes"}},
+    {solid_motion_name(SolidMotion::free),
      {"mass", "initial_velocity", "initial_angular_velocity", "drag", "force",
       "force_until_contact"}},
 }};

@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cosserat/contact/geometry.hpp"
@@ -11,6 +12,12 @@
 namespace cosserat {
 
 enum class SolidMotion { fixed, kinematic, free };
+
+// The motion's name in scene files and run summaries.
+constexpr std::string_view solid_motion_name(SolidMotion motion) {
+  constexpr std::string_view names[] = {"fixed", "kinematic", "free"};
+  return names[static_cast<int>(motion)];
+}
 
 // A kinematic solid's prescribed path: either a constant velocity and angular velocity between
 // start_time and end_time (at rest before and after, where it got to), or keyframes of pose,
