@@ -1,8 +1,11 @@
 #include "cosserat/model/cosserat_energy.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <vector>
 
+#include "energy_interior.hpp"
 #include "surface_geometry.hpp"
 
 // Reach: E_p reads the 3 × 3 box around p, so the force at q reads the gradients of the nodes
@@ -82,10 +85,18 @@ void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
   }
 }
 
+bool any_nonzero(const Sym2& c) { return c[0] != 0.0 || c[1] != 0.0 || c[2] != 0.0; }
+
 }  // namespace
 
 CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest)
-    : block_(&block), h1_(h1), h2_(h2), rest_(rest) {}
+    : block_(&block),
+      h1_(h1),
+      h2_(h2),
+      rest_(rest),
+      interior_{rest.Phi, rest.Psi, rest.Theta, rest.metric, h1 * h2, 1.0 / h1, 1.0 / h2,
+                1.0 / (h1 * h1), 1.0 / (h2 * h2), 1.0 / (h1 * h2)},
+      terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)} {}
 
 // E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (MODEL.md §2.5): the sum
 // over α, β counts the (1, 2) terms twice. Strains as §2.1 computes them.
@@ -167,40 +178,226 @@ double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGr
   return energy;
 }
 
+// The row-fused force (docs/model.md, "Force kernel"): each thread takes a contiguous band of
+// owned rows and walks the rows p of its band, one beyond it on each side, in order. For each
+// row it computes ∂E_p/∂r into row buffers — interior nodes through energy::interior_gradient,
+// eight lanes at a time, the border ring through node_energy — and adds them into the forces of
+// the three rows they touch; a row's force is complete once the row above it is done. Every
+// node's force is −Σ_p ∂E_p/∂r_q summed in one fixed order (rows of p ascending, then the slots
+// in kSlots order), and whether a node is interior depends only on its global index: any
+// decomposition and any thread count give the same bits. The buffers are a few rows long, so
+// the intermediates stay in cache and never take a field.
+namespace {
+
+// The gradient slots, interior ones first (the order of energy::InteriorGradient), then the
+// three only border nodes reach: as (dk, dl) from p.
+struct SlotOffset {
+  int dk, dl;
+};
+constexpr SlotOffset kSlots[9] = {{0, 0}, {1, 0},  {-1, 0}, {0, 1},  {0, -1},
+                                  {1, 1}, {-1, -1}, {1, -1}, {-1, 1}};
+constexpr int kInteriorSlots = 6;
+constexpr int kLanes = 8;  // lanes of one interior block; a multiple of any vector width used
+
+}  // namespace
+
+void CosseratEnergy::RowScratch::resize(int columns) {
+  if (width >= columns) return;
+  width = columns;
+  const auto w = static_cast<std::size_t>(columns);
+  positions.assign(9 * w, 0.0);
+  gradient.assign(27 * w, 0.0);
+  force.assign(9 * w, 0.0);
+  normal.assign(3 * w, 0.0);
+}
+
+// Copies row l of the positions into its ring slot as three component arrays, over the columns
+// the row's interior nodes read; the columns past the grown range continue the row linearly, so
+// the lanes of the last block that lie beyond it compute on a regular sheet (their results are
+// never used, and stay finite).
+void CosseratEnergy::load_row(const Field<Vec3>& R, int l, int k_base, int k_end,
+                              RowScratch& s) const {
+  const int slot = l % 3;
+  if (s.position_row[slot] == l) return;
+  s.position_row[slot] = l;
+  const auto w = static_cast<std::size_t>(s.width);
+  double* x = s.positions.data() + 3 * slot * w;
+  double* y = x + w;
+  double* z = y + w;
+  const int first = std::max(k_base, 0);
+  for (int k = first; k < k_end; ++k) {
+    const Vec3 r = R(k, l);
+    x[k - k_base] = r.x;
+    y[k - k_base] = r.y;
+    z[k - k_base] = r.z;
+  }
+  const int last = k_end - 1 - k_base;
+  const double dx = x[last] - x[last - 1], dy = y[last] - y[last - 1], dz = z[last] - z[last - 1];
+  for (int c = last + 1; c < s.width; ++c) {
+    x[c] = x[c - 1] + dx;
+    y[c] = y[c - 1] + dy;
+    z[c] = z[c - 1] + dz;
+  }
+}
+
+template <bool Bending, bool Coupling, bool Normal>
+void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const {
+  const auto w = static_cast<std::size_t>(s.width);
+  const double* below = s.positions.data() + 3 * ((l - 1) % 3) * w;
+  const double* here = s.positions.data() + 3 * (l % 3) * w;
+  const double* above = s.positions.data() + 3 * ((l + 1) % 3) * w;
+  double* G = s.gradient.data();
+  double* N = s.normal.data();
+  const energy::InteriorCoefficients& co = interior_;
+  for (int block = ka - k_base; block < kb - k_base; block += kLanes) {
+#pragma omp simd
+    for (int lane = 0; lane < kLanes; ++lane) {
+      const std::size_t c = static_cast<std::size_t>(block + lane);
+      auto at = [&](const double* row, std::size_t i) {
+        return Vec3{row[i], row[w + i], row[2 * w + i]};
+      };
+      Vec3 n;
+      const energy::InteriorGradient g = energy::interior_gradient<Bending, Coupling, Normal>(
+          co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c), at(below, c),
+          at(above, c + 1), n);
+      const Vec3* slot[kInteriorSlots] = {&g.centre, &g.right, &g.left,
+                                          &g.up,     &g.down,  &g.up_right};
+      for (int q = 0; q < kInteriorSlots; ++q) {
+        G[(3 * q + 0) * w + c] = slot[q]->x;
+        G[(3 * q + 1) * w + c] = slot[q]->y;
+        G[(3 * q + 2) * w + c] = slot[q]->z;
+      }
+      if (Normal) {
+        N[c] = n.x;
+        N[w + c] = n.y;
+        N[2 * w + c] = n.z;
+      }
+    }
+  }
+}
+
+// One border node through node_energy, into the row buffers.
+void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
+                                 RowScratch& s) const {
+  StencilGradient g;
+  Vec3 n;
+  node_energy(R, k, l, &g, &n);
+  const auto w = static_cast<std::size_t>(s.width);
+  const std::size_t c = static_cast<std::size_t>(k - k_base);
+  for (int q = 0; q < 9; ++q) {
+    const Vec3 v = g[slot(kSlots[q].dk, kSlots[q].dl)];
+    s.gradient[(3 * q + 0) * w + c] = v.x;
+    s.gradient[(3 * q + 1) * w + c] = v.y;
+    s.gradient[(3 * q + 2) * w + c] = v.z;
+  }
+  s.normal[c] = n.x;
+  s.normal[w + c] = n.y;
+  s.normal[2 * w + c] = n.z;
+}
+
+template <bool Bending, bool Coupling, bool Normal>
+void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>* normals,
+                          int qa, int qb, RowScratch& s) const {
+  const Block& b = *block_;
+  const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
+  const int k_base = gk0 - 1;  // column 0; the force buffers take p's slots at k − 1
+  const int ka = std::max(gk0, 1), kb = std::min(gk1, b.m - 1);  // interior columns
+  const auto w = static_cast<std::size_t>(s.width);
+  auto force_row = [&](int q) { return s.force.data() + 3 * (q % 3) * w; };
+  auto clear = [&](int q) { std::fill_n(force_row(q), 3 * w, 0.0); };
+  auto write_out = [&](int q) {
+    const double* f = force_row(q);
+    for (int k = b.k0; k < b.k1; ++k) {
+      const std::size_t c = static_cast<std::size_t>(k - k_base);
+      force(k, q) = {f[c], f[w + c], f[2 * w + c]};
+    }
+  };
+
+  const int pa = std::max(qa - 1, 0), pb = std::min(qb + 1, b.n);
+  s.position_row[0] = s.position_row[1] = s.position_row[2] = -1;  // positions have moved
+  for (int q = pa; q < pa + 3; ++q) clear(q);
+  for (int l = pa; l < pb; ++l) {
+    if (l > pa) clear(l + 1);
+    const bool border_row = l == 0 || l == b.n - 1;
+    if (border_row) {
+      for (int k = gk0; k < gk1; ++k) border_node(R, k, l, k_base, s);
+    } else {
+      const int k_end = std::min(gk1 + 1, b.m);
+      load_row(R, l - 1, k_base, k_end, s);
+      load_row(R, l, k_base, k_end, s);
+      load_row(R, l + 1, k_base, k_end, s);
+      if (ka < kb) interior_row<Bending, Coupling, Normal>(l, ka, kb, k_base, s);
+      if (gk0 == 0) border_node(R, 0, l, k_base, s);
+      if (gk1 == b.m) border_node(R, b.m - 1, l, k_base, s);
+    }
+    if (normals != nullptr && l >= qa && l < qb)
+      for (int k = b.k0; k < b.k1; ++k) {
+        const std::size_t c = static_cast<std::size_t>(k - k_base);
+        (*normals)(k, l) = {s.normal[c], s.normal[w + c], s.normal[2 * w + c]};
+      }
+
+    // f_q −= ∂E_p/∂r_q, slot by slot: within one slot each q takes at most one term.
+    auto scatter = [&](int q, int c0, int c1) {
+      const int fl = l + kSlots[q].dl;
+      if (fl < 0 || fl >= b.n) return;
+      const int dk = kSlots[q].dk;
+      for (int component = 0; component < 3; ++component) {
+        double* f = force_row(fl) + component * w + dk;
+        const double* g = s.gradient.data() + (3 * q + component) * w;
+#pragma omp simd
+        for (int c = c0; c < c1; ++c) f[c] -= g[c];
+      }
+    };
+    const int c0 = gk0 - k_base, c1 = gk1 - k_base;
+    for (int q = 0; q < kInteriorSlots; ++q) scatter(q, c0, c1);
+    for (int q = kInteriorSlots; q < 9; ++q) {
+      if (border_row) {
+        scatter(q, c0, c1);
+      } else {
+        if (gk0 == 0) scatter(q, c0, c0 + 1);
+        if (gk1 == b.m) scatter(q, c1 - 1, c1);
+      }
+    }
+    if (l - 1 >= qa && l - 1 < qb) write_out(l - 1);
+  }
+  if (pb == b.n && b.n - 1 >= qa && b.n - 1 < qb) write_out(b.n - 1);
+}
+
 void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
                                     Field<Vec3>* normals) {
   const Block& b = *block_;
-  // A flux-form run asks only for the energy, and never carries this field.
-  if (!has_gradient_field_) {
-    gradient_ = Field<StencilGradient>(b);
-    has_gradient_field_ = true;
-  }
-  // Gradients on the owned range grown by one node, clipped to the grid.
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
-  const int gl0 = std::max(b.l0 - 1, 0), gl1 = std::min(b.l1 + 1, b.n);
+  // Columns from gk0 − 1 to gk1, and the last interior block's lanes past it.
+  const int columns = (gk1 - gk0 + 2) + 2 * kLanes;
+  const bool bending = terms_.bending, coupling = terms_.coupling;
 #pragma omp parallel
   {
-#pragma omp for schedule(static)
-    for (int l = gl0; l < gl1; ++l)
-      for (int k = gk0; k < gk1; ++k) {
-        Vec3 n;
-        node_energy(r, k, l, &gradient_(k, l), &n);
-        if (normals != nullptr && b.owns(k, l)) (*normals)(k, l) = n;
+    const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+#pragma omp single
+    if (static_cast<int>(scratch_.size()) < threads) scratch_.resize(static_cast<std::size_t>(threads));
+    // Each thread sizes, and so first touches, its own buffers.
+    RowScratch& s = scratch_[static_cast<std::size_t>(t)];
+    s.resize(columns);
+    const long rows = b.owned_l();
+    const int qa = b.l0 + static_cast<int>(rows * t / threads);
+    const int qb = b.l0 + static_cast<int>(rows * (t + 1) / threads);
+    if (qa < qb) {
+      if (normals != nullptr) {
+        if (!bending)
+          band<false, false, true>(r, force, normals, qa, qb, s);
+        else if (coupling)
+          band<true, true, true>(r, force, normals, qa, qb, s);
+        else
+          band<true, false, true>(r, force, normals, qa, qb, s);
+      } else {
+        if (!bending)
+          band<false, false, false>(r, force, normals, qa, qb, s);
+        else if (coupling)
+          band<true, true, false>(r, force, normals, qa, qb, s);
+        else
+          band<true, false, false>(r, force, normals, qa, qb, s);
       }
-
-    // f_q = −Σ_p ∂E_p/∂r_q over the nodes p around q, in one fixed order.
-#pragma omp for schedule(static)
-    for (int l = b.l0; l < b.l1; ++l)
-      for (int k = b.k0; k < b.k1; ++k) {
-        Vec3 f;
-        for (int dl = -1; dl <= 1; ++dl)
-          for (int dk = -1; dk <= 1; ++dk) {
-            const int pk = k + dk, pl = l + dl;
-            if (pk < 0 || pk >= b.m || pl < 0 || pl >= b.n) continue;
-            f -= gradient_(pk, pl)[slot(-dk, -dl)];
-          }
-        force(k, l) = f;
-      }
+    }
   }
 }
 

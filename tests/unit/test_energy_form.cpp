@@ -64,6 +64,79 @@ TEST(EnergyForm, ForceIsMinusTheGradientOfTheEnergy) {
   EXPECT_LT(worst, 1e-6 * largest) << "largest force component " << largest;
 }
 
+// The row kernel (interior nodes eight lanes at a time, the border ring through node_energy)
+// against the definition: f_q = −Σ_p ∂E_p/∂r_q with every gradient from node_energy, on sheets
+// whose rows are shorter than, equal to and longer than a lane block, for every combination of
+// terms the kernel specialises (no curvature, no coupling, all), with and without normals, on
+// the whole grid and on a block of it. Only the order of the sums differs, so the two agree to
+// round-off.
+TEST(EnergyForm, RowKernelAgreesWithTheNodeGradients) {
+  struct Case {
+    int m, n;
+    Sym2 xi, phi;
+  };
+  const Case cases[] = {{3, 3, {0.3, 0.2, 0.4}, {0.05, 0.02, 0.03}},
+                        {9, 5, {0.3, 0.2, 0.4}, {0.05, 0.02, 0.03}},
+                        {10, 12, {0.3, 0.2, 0.4}, {0.0, 0.0, 0.0}},
+                        {21, 7, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}},
+                        {19, 17, {0.0, 0.0, 0.0}, {0.05, 0.0, 0.0}}};
+  for (const Case& c : cases) {
+    Scene scene = testing::flat_sheet(c.m, c.n);
+    scene.size2 = 8.0;
+    scene.material.xi = c.xi;
+    scene.material.phi = c.phi;
+    const RestState rest = flat_rest_state(scene.material, scene.u, scene.v);
+    Block whole = Block::whole(c.m, c.n, MPI_COMM_SELF);
+    // A block of the grid away from its borders on the low sides, reaching them on the high.
+    Block part = whole;
+    part.k0 = c.m / 3;
+    part.l0 = c.n / 2;
+    for (const Block* block : {&whole, &part}) {
+      const Block& b = *block;
+      Field<Vec3> r(b), force(b), normals(b);
+      for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
+        for (int k = std::max(b.k0 - b.ghost, 0); k < std::min(b.k1 + b.ghost, b.m); ++k)
+          r(k, l) = testing::deformed(scene, k, l);
+      CosseratEnergy energy(b, scene.h1(), scene.h2(), rest);
+      // A first call at rest positions: nothing of it may carry into the next.
+      {
+        Field<Vec3> rest_r(b);
+        for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
+          for (int k = std::max(b.k0 - b.ghost, 0); k < std::min(b.k1 + b.ghost, b.m); ++k)
+            rest_r(k, l) = (k * scene.h1()) * scene.u + (l * scene.h2()) * scene.v;
+        energy.internal_force(rest_r, force);
+      }
+      for (const bool with_normals : {false, true}) {
+        energy.internal_force(r, force, with_normals ? &normals : nullptr);
+        double worst = 0.0, largest = 0.0, worst_normal = 0.0;
+        for (int l = b.l0; l < b.l1; ++l)
+          for (int k = b.k0; k < b.k1; ++k) {
+            Vec3 expected;
+            for (int dl = -1; dl <= 1; ++dl)
+              for (int dk = -1; dk <= 1; ++dk) {
+                const int pk = k + dk, pl = l + dl;
+                if (pk < 0 || pk >= b.m || pl < 0 || pl >= b.n) continue;
+                CosseratEnergy::StencilGradient g;
+                energy.node_energy(r, pk, pl, &g);
+                expected -= g[3 * (1 - dl) + (1 - dk)];
+              }
+            worst = std::max(worst, norm(force(k, l) - expected));
+            largest = std::max(largest, norm(expected));
+            if (with_normals) {
+              Vec3 n;
+              energy.node_energy(r, k, l, nullptr, &n);
+              worst_normal = std::max(worst_normal, norm(normals(k, l) - n));
+            }
+          }
+        ASSERT_GT(largest, 1.0);
+        EXPECT_LT(worst, 1e-12 * largest)
+            << c.m << " x " << c.n << " block from (" << b.k0 << ", " << b.l0 << ")";
+        EXPECT_LT(worst_normal, 1e-14) << c.m << " x " << c.n;
+      }
+    }
+  }
+}
+
 // The Jacobian of the force is the negative Hessian of E: symmetric, to finite-difference noise.
 TEST(EnergyForm, JacobianIsSymmetric) {
   Sheet sheet(coupled_sheet());

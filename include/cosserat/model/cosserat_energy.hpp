@@ -3,12 +3,36 @@
 // §2.1, summed over the nodes, and the internal force as its exact negative gradient.
 
 #include <array>
+#include <vector>
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "cosserat/grid/vec3.hpp"
 
 namespace cosserat {
+
+namespace energy {
+
+// The constants of the interior gradient: the moduli of §1 at rest, the rest metric and the
+// finite-difference factors, each reciprocal taken once (Vec3's division multiplies by the
+// reciprocal too, so r/h and r·(1/h) are the same bits).
+struct InteriorCoefficients {
+  Sym2 Phi, Psi, Theta, A;
+  double area;                 // h₁h₂
+  double inv_h1, inv_h2;       // 1/h_α
+  double inv_h11, inv_h22;     // 1/h_α²
+  double inv_h12;              // 1/(h₁h₂)
+};
+
+// The terms a material switches off: ξ = 0 and φ = 0 leave no curvature term at all (Ψ = Θ =
+// 0), φ = 0 no coupling (Θ = 0); a kernel built without them skips their arithmetic. Skipping
+// is exact: every skipped product has a zero factor.
+struct Terms {
+  bool bending;   // Ψ or Θ nonzero: κ enters E
+  bool coupling;  // Θ nonzero
+};
+
+}  // namespace energy
 
 class CosseratEnergy {
  public:
@@ -32,11 +56,29 @@ class CosseratEnergy {
                      Vec3* normal = nullptr) const;
 
  private:
+  // One thread's row buffers (internal_force): three rows of positions and of forces, and one
+  // row of gradients (nine slots) and normals, each component a contiguous array of `width`.
+  struct RowScratch {
+    int width = 0;
+    std::vector<double> positions, gradient, force, normal;
+    int position_row[3] = {-1, -1, -1};  // the grid row each positions slot holds
+    void resize(int columns);
+  };
+
+  void load_row(const Field<Vec3>& positions, int l, int k_base, int k_end, RowScratch& s) const;
+  template <bool Bending, bool Coupling, bool Normal>
+  void interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const;
+  void border_node(const Field<Vec3>& positions, int k, int l, int k_base, RowScratch& s) const;
+  template <bool Bending, bool Coupling, bool Normal>
+  void band(const Field<Vec3>& positions, Field<Vec3>& force, Field<Vec3>* normals, int qa,
+            int qb, RowScratch& s) const;
+
   const Block* block_;
   double h1_, h2_;
   RestState rest_;
-  Field<StencilGradient> gradient_;  // allocated by the first internal_force
-  bool has_gradient_field_ = false;
+  energy::InteriorCoefficients interior_;
+  energy::Terms terms_;
+  std::vector<RowScratch> scratch_;  // one per thread, sized by the first internal_force
 };
 
 }  // namespace cosserat
