@@ -297,7 +297,7 @@ void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
 
 template <bool Bending, bool Coupling, bool Normal>
 void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>* normals,
-                          int qa, int qb, RowScratch& s) const {
+                          double scale, const Vec3& offset, int qa, int qb, RowScratch& s) const {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   const int k_base = gk0 - 1;  // column 0; the force buffers take p's slots at k − 1
@@ -309,7 +309,7 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>*
     const double* f = force_row(q);
     for (int k = b.k0; k < b.k1; ++k) {
       const std::size_t c = static_cast<std::size_t>(k - k_base);
-      force(k, q) = {f[c], f[w + c], f[2 * w + c]};
+      force(k, q) = scale * Vec3{f[c], f[w + c], f[2 * w + c]} + offset;
     }
   };
 
@@ -336,26 +336,50 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>*
         (*normals)(k, l) = {s.normal[c], s.normal[w + c], s.normal[2 * w + c]};
       }
 
-    // f_q −= ∂E_p/∂r_q, slot by slot: within one slot each q takes at most one term.
-    auto scatter = [&](int q, int c0, int c1) {
+    // f_q −= ∂E_p/∂r_q. The interior slots are gathered per force row, each q taking its terms
+    // from p = q − (dk, dl) in slot order; the columns just outside the row's range read as
+    // zero (p outside the grid, or a q that is not owned).
+    const int c0 = gk0 - k_base, c1 = gk1 - k_base;
+    for (int q = 0; q < kInteriorSlots; ++q)
+      for (int component = 0; component < 3; ++component) {
+        double* g = s.gradient.data() + (3 * q + component) * w;
+        g[c0 - 1] = 0.0;
+        g[c1] = 0.0;
+      }
+    auto slot_row = [&](int q, int component) {
+      return s.gradient.data() + (3 * q + component) * w;
+    };
+    for (int component = 0; component < 3; ++component) {
+      const double *centre = slot_row(0, component), *right = slot_row(1, component),
+                   *left = slot_row(2, component), *up = slot_row(3, component),
+                   *down = slot_row(4, component), *up_right = slot_row(5, component);
+      double* f = force_row(l) + component * w;
+#pragma omp simd
+      for (int c = c0; c < c1; ++c) f[c] = ((f[c] - centre[c]) - right[c - 1]) - left[c + 1];
+      if (l + 1 < b.n) {
+        double* f_above = force_row(l + 1) + component * w;
+#pragma omp simd
+        for (int c = c0; c < c1; ++c) f_above[c] = (f_above[c] - up[c]) - up_right[c - 1];
+      }
+      if (l > 0) {
+        double* f_below = force_row(l - 1) + component * w;
+#pragma omp simd
+        for (int c = c0; c < c1; ++c) f_below[c] -= down[c];
+      }
+    }
+    // The slots only border nodes reach, scattered from those nodes.
+    auto scatter = [&](int q, int c) {
       const int fl = l + kSlots[q].dl;
       if (fl < 0 || fl >= b.n) return;
-      const int dk = kSlots[q].dk;
-      for (int component = 0; component < 3; ++component) {
-        double* f = force_row(fl) + component * w + dk;
-        const double* g = s.gradient.data() + (3 * q + component) * w;
-#pragma omp simd
-        for (int c = c0; c < c1; ++c) f[c] -= g[c];
-      }
+      for (int component = 0; component < 3; ++component)
+        force_row(fl)[component * w + c + kSlots[q].dk] -= slot_row(q, component)[c];
     };
-    const int c0 = gk0 - k_base, c1 = gk1 - k_base;
-    for (int q = 0; q < kInteriorSlots; ++q) scatter(q, c0, c1);
     for (int q = kInteriorSlots; q < 9; ++q) {
       if (border_row) {
-        scatter(q, c0, c1);
+        for (int c = c0; c < c1; ++c) scatter(q, c);
       } else {
-        if (gk0 == 0) scatter(q, c0, c0 + 1);
-        if (gk1 == b.m) scatter(q, c1 - 1, c1);
+        if (gk0 == 0) scatter(q, c0);
+        if (gk1 == b.m) scatter(q, c1 - 1);
       }
     }
     if (l - 1 >= qa && l - 1 < qb) write_out(l - 1);
@@ -364,7 +388,7 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>*
 }
 
 void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
-                                    Field<Vec3>* normals) {
+                                    Field<Vec3>* normals, double scale, const Vec3& offset) {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   // Columns from gk0 − 1 to gk1, and the last interior block's lanes past it.
@@ -384,18 +408,18 @@ void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
     if (qa < qb) {
       if (normals != nullptr) {
         if (!bending)
-          band<false, false, true>(r, force, normals, qa, qb, s);
+          band<false, false, true>(r, force, normals, scale, offset, qa, qb, s);
         else if (coupling)
-          band<true, true, true>(r, force, normals, qa, qb, s);
+          band<true, true, true>(r, force, normals, scale, offset, qa, qb, s);
         else
-          band<true, false, true>(r, force, normals, qa, qb, s);
+          band<true, false, true>(r, force, normals, scale, offset, qa, qb, s);
       } else {
         if (!bending)
-          band<false, false, false>(r, force, normals, qa, qb, s);
+          band<false, false, false>(r, force, normals, scale, offset, qa, qb, s);
         else if (coupling)
-          band<true, true, false>(r, force, normals, qa, qb, s);
+          band<true, true, false>(r, force, normals, scale, offset, qa, qb, s);
         else
-          band<true, false, false>(r, force, normals, qa, qb, s);
+          band<true, false, false>(r, force, normals, scale, offset, qa, qb, s);
       }
     }
   }

@@ -46,34 +46,35 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
                                           Field<Vec3>* normals) {
   const Block& b = *block_;
   assert((normals != nullptr) == has_fluid());
-  double inverse_density = 0.0, internal_scale = 0.0;
+  const Vec3 g = gravity_;
+  const bool fluid = fluid_.has_value();
+  double inverse_density = 0.0;
   if (flux_) {
     flux_->internal_force(r, a, normals);
     // S/M = 1/μ; the internal force carries f = S0/S, so its acceleration is f̂ S0/M (§3).
     if (needs_area_) inverse_density = total_area(r) / mass_;
-    internal_scale = rest_area_ / mass_;
+    const double internal_scale = rest_area_ / mass_;
+#pragma omp parallel for schedule(static)
+    for (int l = b.l0; l < b.l1; ++l)
+#pragma omp simd
+      for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l) + g;
   } else {
-    // Newtons on the constant nodal mass μ0 h1 h2 (§2.5); loads, damping and fluid per unit
-    // area act on μ0.
-    energy_.internal_force(r, a, normals);
+    // Newtons on the constant nodal mass μ0 h1 h2 (§2.5), with gravity, written by the kernel;
+    // loads, damping and fluid per unit area act on μ0.
+    energy_.internal_force(r, a, normals, 1.0 / node_mass_, g);
     inverse_density = rest_area_ / mass_;
-    internal_scale = 1.0 / node_mass_;
   }
-  const Vec3 g = gravity_;
-  const bool fluid = fluid_.has_value();
   const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
   const Vec3 fluid_velocity = fluid ? fluid_->velocity : Vec3{};
-
+  if (fluid) {
 #pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) {
-      Vec3 acc = internal_scale * a(k, l) + g;
-      if (fluid) {
+    for (int l = b.l0; l < b.l1; ++l)
+#pragma omp simd
+      for (int k = b.k0; k < b.k1; ++k) {
         const Vec3 n = (*normals)(k, l);
-        acc += (fluid_coefficient * dot(n, fluid_velocity)) * n;
+        a(k, l) += (fluid_coefficient * dot(n, fluid_velocity)) * n;
       }
-      a(k, l) = acc;
-    }
+  }
   // Point loads are newtons on the node's lumped mass μ h1 h2 (MODEL.md §1).
   for (const PointLoad& load : loads_)
     if (load.window.contains(step, time_))
@@ -86,15 +87,13 @@ double Dynamics::elastic_energy(const Field<Vec3>& r) {
 }
 
 void Dynamics::internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a) {
-  const Block& b = *block_;
-  double internal_scale = 0.0;
-  if (flux_) {
-    flux_->internal_force(r, a);
-    internal_scale = rest_area_ / mass_;
-  } else {
-    energy_.internal_force(r, a);
-    internal_scale = 1.0 / node_mass_;
+  if (!flux_) {
+    energy_.internal_force(r, a, nullptr, 1.0 / node_mass_);
+    return;
   }
+  const Block& b = *block_;
+  flux_->internal_force(r, a);
+  const double internal_scale = rest_area_ / mass_;
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l);

@@ -42,8 +42,11 @@ class CosseratEnergy {
   // it, so the force at q gathers the gradients of the nine nodes around q, always in the same
   // order: any decomposition gives the same bits. Reads positions two nodes beyond the owned
   // range (ghosts must be current). With `normals`, also the unit normal n of every owned node.
+  // Writes scale · f + offset, so that the step's acceleration f/m + g takes no sweep of its
+  // own.
   void internal_force(const Field<Vec3>& positions, Field<Vec3>& force,
-                      Field<Vec3>* normals = nullptr);
+                      Field<Vec3>* normals = nullptr, double scale = 1.0,
+                      const Vec3& offset = {});
 
   // This block's share of E (J): the energies of the nodes it owns, summed row by row in order.
   // Reads the ghosts one node beyond the owned range.
@@ -70,8 +73,8 @@ class CosseratEnergy {
   void interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const;
   void border_node(const Field<Vec3>& positions, int k, int l, int k_base, RowScratch& s) const;
   template <bool Bending, bool Coupling, bool Normal>
-  void band(const Field<Vec3>& positions, Field<Vec3>& force, Field<Vec3>* normals, int qa,
-            int qb, RowScratch& s) const;
+  void band(const Field<Vec3>& positions, Field<Vec3>& force, Field<Vec3>* normals,
+            double scale, const Vec3& offset, int qa, int qb, RowScratch& s) const;
 
   const Block* block_;
   double h1_, h2_;
