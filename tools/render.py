@@ -55,8 +55,8 @@ MAX_LINES = 160
 # the detail: this many rows and columns find a fold's place to a fiftieth of the sheet.
 SURVEY_LINES = 48
 DPI = 100
-# The figure is drawn this large, then cut to the ink: about 800 px across the box.
-DRAWING_SIZE_PX = (1100, 900)
+# The figure is drawn this large, then cut to the ink: about 750 px across the box.
+DRAWING_SIZE_PX = (1000, 820)
 MIN_WIDTH_PX = 640
 MARGIN_PX = 12
 HEADER_PX = 58
