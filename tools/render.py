@@ -88,6 +88,10 @@ FEW_HELD = 40
 # A GIF frame has 256 colours and compresses poorly (5 MB for S4's 101 frames at full size):
 # it is written at this fraction of the picture's size.
 GIF_SCALE = 0.6
+# An animation plays at FPS frames a second, or slower when that would make it shorter than
+# SHORTEST_ANIMATION seconds: a fold that grows over thirty frames takes more than a second.
+FPS = 20.0
+SHORTEST_ANIMATION = 5.0
 
 
 @dataclass(frozen=True)
@@ -137,8 +141,9 @@ def parse_arguments(argv):
     parser.add_argument("--max-frames", type=int, default=150,
                         help="the animation takes every k-th frame, k the smallest that keeps "
                              "it to this many with the last frame added (default 150)")
-    parser.add_argument("--fps", type=float, default=20.0,
-                        help="animation frames per second (default 20)")
+    parser.add_argument("--fps", type=float,
+                        help="animation frames per second (default 20, fewer for an animation "
+                             "of under 100 frames, so that it lasts 5 s)")
     parser.add_argument("--elev", type=float,
                         help="camera elevation, degrees (default: from the sheet's shape)")
     parser.add_argument("--azim", type=float,
@@ -148,7 +153,7 @@ def parse_arguments(argv):
     arguments = parser.parse_args(argv)
     if arguments.max_frames < 2:
         parser.error("--max-frames must be at least 2 (the first and the last frame)")
-    if arguments.fps <= 0:
+    if arguments.fps is not None and arguments.fps <= 0:
         parser.error("--fps must be positive")
     return arguments
 
@@ -671,13 +676,16 @@ def animation_writer(path, fps):
 def render(arguments, run):
     """Write the picture and, with --animate, the animation; return the paths written."""
     index = frame_index(run, arguments.frame, arguments.time)
-    movie_writer = animation_writer(arguments.animate, arguments.fps) if arguments.animate else None
+    movie_frames, movie_writer = [], None
+    if arguments.animate:
+        movie_frames = animation_frames(run.frames, arguments.max_frames)
+        fps = arguments.fps or min(FPS, len(movie_frames) / SHORTEST_ANIMATION)
+        movie_writer = animation_writer(arguments.animate, fps)
     constraints = read_constraints(run, arguments.scene)
     swept = survey(run)
     chosen = index is None
     if chosen:
         index = int(swept.deformations.argmax())
-    movie_frames = animation_frames(run.frames, arguments.max_frames) if movie_writer else []
     field = FIELDS[arguments.field]
     sheet = Sheet(run, arguments.field)
     values = {frame: sheet.values(frame) for frame in {index, *movie_frames}}
