@@ -111,7 +111,8 @@ if ((!quick)); then
   for s in silk_square cotton_square denim_square s6_loads_x5 s6_xi0 s4_flag_preset crumple; do
     for idx in "${!cases[@]}"; do
       [[ ${cases[$idx]%%|*} == "$s" ]] || continue
-      /usr/bin/python3 tools/render.py "$work/$idx-energy.h5" --output "$stem-$s.png" >/dev/null 2>&1 ||
+      /usr/bin/python3 tools/render.py "$work/$idx-energy.h5" --frame -1 --output "$stem-$s.png" \
+        >/dev/null 2>&1 ||
         echo "render of $s failed" >&2
     done
   done
