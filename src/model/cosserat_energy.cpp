@@ -225,11 +225,15 @@ void CosseratEnergy::load_row(const Field<Vec3>& R, int l, int k_base, int k_end
   double* y = x + w;
   double* z = y + w;
   const int first = std::max(k_base, 0);
-  for (int k = first; k < k_end; ++k) {
-    const Vec3 r = R(k, l);
-    x[k - k_base] = r.x;
-    y[k - k_base] = r.y;
-    z[k - k_base] = r.z;
+  // Vec3 is three packed doubles, so the row is one interleaved array the loop de-interleaves.
+  static_assert(sizeof(Vec3) == 3 * sizeof(double));
+  const double* source = &R(first, l).x;
+  const int offset = first - k_base;
+#pragma omp simd
+  for (int i = 0; i < k_end - first; ++i) {
+    x[offset + i] = source[3 * i];
+    y[offset + i] = source[3 * i + 1];
+    z[offset + i] = source[3 * i + 2];
   }
   const int last = k_end - 1 - k_base;
   const double dx = x[last] - x[last - 1], dy = y[last] - y[last - 1], dz = z[last] - z[last - 1];
