@@ -6,8 +6,12 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <cassert>
 #include <cstddef>
+#include <memory>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace cosserat {
@@ -55,12 +59,42 @@ struct Block {
   bool owns(int k, int l) const { return k >= k0 && k < k1 && l >= l0 && l < l1; }
 };
 
-// One value per node of a block, ghosts included, in one contiguous array.
+// Leaves an element built without arguments untouched, so that a vector's pages are first
+// written, and so placed in memory near the core, by whoever fills it (Field below). Only for
+// implicit-lifetime types, whose bytes need no constructor to be a value.
+template <class T>
+struct UntouchedAllocator : std::allocator<T> {
+  static_assert(std::is_trivially_copyable_v<T> && std::is_trivially_destructible_v<T>);
+  template <class U>
+  struct rebind {
+    using other = UntouchedAllocator<U>;
+  };
+  UntouchedAllocator() = default;
+  template <class U>
+  UntouchedAllocator(const UntouchedAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U*) noexcept {}
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+// One value per node of a block, ghosts included, in one contiguous array. Its rows are zeroed
+// by the threads that later sweep them (static schedule over rows, as every sweep uses), so
+// on a machine with several memory domains each thread's rows sit in its own.
 template <class T>
 class Field {
  public:
   Field() = default;
-  explicit Field(const Block& block) : block_(&block), data_(block.local_size()) {}
+  explicit Field(const Block& block) : block_(&block), data_(block.local_size()) {
+    const int rows = block.owned_l() + 2 * block.ghost;
+    const auto stride = static_cast<std::size_t>(block.stride());
+    T* data = data_.data();
+#pragma omp parallel for schedule(static)
+    for (int row = 0; row < rows; ++row)
+      std::fill_n(data + static_cast<std::size_t>(row) * stride, stride, T{});
+  }
 
   T& operator()(int k, int l) { return data_[block_->index(k, l)]; }
   const T& operator()(int k, int l) const { return data_[block_->index(k, l)]; }
@@ -74,7 +108,7 @@ class Field {
 
  private:
   const Block* block_ = nullptr;
-  std::vector<T> data_;
+  std::vector<T, UntouchedAllocator<T>> data_;
 };
 
 }  // namespace cosserat
