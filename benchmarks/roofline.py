@@ -1,0 +1,105 @@
+#!/usr/bin/python3
+"""Roofline plot of kernels against the machine's ceilings.
+
+Reads a JSON file of ceilings and kernel points and writes a log-log PNG: arithmetic
+intensity (flops per byte) on x, GFLOP/s on y, each compute ceiling a horizontal line, each
+bandwidth a diagonal, each kernel a point labelled with its node-steps per second and the
+fraction it reaches of its roofline bound, min(compute, intensity × bandwidth) for the
+ceilings it names.
+
+  {"title": "...", "note": "machine, compiler, date (printed under the plot)",
+   "compute": [{"name": "FP64 FMA zmm, 1 thread", "gflops": 86.3}, ...],
+   "bandwidth": [{"name": "L3, 1 thread", "gbs": 30.1}, ...],
+   "kernels": [{"name": "Verlet step, 1024²", "flops_per_node_step": 792,
+                "bytes_per_node_step": 936, "node_steps_per_second": 2.9e6,
+                "compute": "FP64 FMA zmm, 1 thread", "bandwidth": "L3, 1 thread"}]}
+
+A kernel's "compute" and "bandwidth" default to the first of each list.
+
+  /usr/bin/python3 benchmarks/roofline.py roofline.json roofline.png
+"""
+
+import json
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def bound(kernel, compute, bandwidth):
+    """The kernel's roofline bound in GFLOP/s and the ceiling that sets it."""
+    peak = compute[kernel.get("compute", next(iter(compute)))]
+    bw_name = kernel.get("bandwidth", next(iter(bandwidth)))
+    intensity = kernel["flops_per_node_step"] / kernel["bytes_per_node_step"]
+    memory = intensity * bandwidth[bw_name]
+    if memory < peak:
+        return memory, bw_name
+    return peak, kernel.get("compute", next(iter(compute)))
+
+
+def plot(spec, path):
+    compute = {c["name"]: c["gflops"] for c in spec["compute"]}
+    bandwidth = {b["name"]: b["gbs"] for b in spec["bandwidth"]}
+    kernels = spec["kernels"]
+    intensities = [k["flops_per_node_step"] / k["bytes_per_node_step"] for k in kernels]
+    top = max(compute.values())
+    x_lo = min([0.05] + [0.3 * i for i in intensities])
+    x_hi = max([100.0] + [3 * i for i in intensities])
+    y_lo = min([0.5] + [0.3 * k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
+                        for k in kernels])
+    x = np.logspace(np.log10(x_lo), np.log10(x_hi), 400)
+
+    fig, ax = plt.subplots(figsize=(9, 6.5))
+    for i, (name, gbs) in enumerate(sorted(bandwidth.items(), key=lambda item: -item[1])):
+        ax.plot(x, np.minimum(x * gbs, top), color=f"C{i}", lw=1.6)
+        # Labelled along the diagonal, where it is still below the highest roof.
+        xl = x_lo * 1.6
+        ax.text(xl, xl * gbs * 1.15, f"{name}: {gbs:.0f} GB/s", color=f"C{i}", rotation=0,
+                fontsize=8, va="bottom")
+    for j, (name, gflops) in enumerate(sorted(compute.items(), key=lambda item: -item[1])):
+        ax.axhline(gflops, color="black", lw=1.4 if j == 0 else 0.9, ls="-" if j == 0 else "--",
+                   xmin=0, xmax=1)
+        ax.text(x_hi / 1.1, gflops * 1.06, f"{name}: {gflops:.1f} GFLOP/s", ha="right",
+                fontsize=8)
+
+    for i, (k, intensity) in enumerate(zip(kernels, intensities)):
+        gflops = k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
+        limit, limit_name = bound(k, compute, bandwidth)
+        marker = "os^Dv"[i % 5]
+        ax.plot(intensity, gflops, marker, color="crimson", ms=8, zorder=5)
+        ax.plot([intensity, intensity], [gflops, limit], color="crimson", lw=0.8, ls=":")
+        ax.annotate(f"{k['name']}\n{k['node_steps_per_second']:.2e} node-steps/s, "
+                    f"{gflops:.2f} GFLOP/s\n{gflops / limit:.1%} of its bound "
+                    f"({limit:.1f} GFLOP/s, {limit_name})\n"
+                    f"{k['flops_per_node_step']:.0f} flops, {k['bytes_per_node_step']:.0f} B "
+                    f"per node-step",
+                    (intensity, gflops), xytext=(12, -12 - 44 * i), textcoords="offset points",
+                    fontsize=8, color="crimson", va="top")
+
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(x_lo, x_hi)
+    ax.set_ylim(y_lo, top * 2.5)
+    ax.set_xlabel("arithmetic intensity (FP64 flops per byte)")
+    ax.set_ylabel("GFLOP/s (FP64)")
+    ax.set_title(spec.get("title", "roofline"))
+    ax.grid(True, which="both", lw=0.3, alpha=0.5)
+    if spec.get("note"):
+        fig.text(0.01, 0.005, spec["note"], fontsize=7, va="bottom")
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
+    fig.savefig(path, dpi=130)
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__)
+    with open(sys.argv[1]) as f:
+        spec = json.load(f)
+    plot(spec, sys.argv[2])
+
+
+if __name__ == "__main__":
+    main()
