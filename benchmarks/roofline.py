@@ -14,13 +14,16 @@ ceilings it names.
                 "bytes_per_node_step": 936, "node_steps_per_second": 2.9e6,
                 "compute": "FP64 FMA zmm, 1 thread", "bandwidth": "L3, 1 thread"}]}
 
-A kernel's "compute" and "bandwidth" default to the first of each list.
+A kernel's "compute" and "bandwidth" default to the first of each list. Given several files
+(e.g. before and after a rewrite), the plot takes the ceilings and title of the first and the
+kernels of all.
 
-  /usr/bin/python3 benchmarks/roofline.py roofline.json roofline.png
+  /usr/bin/python3 benchmarks/roofline.py roofline.json [more.json ...] roofline.png
 """
 
 import json
 import sys
+import textwrap
 
 import matplotlib
 
@@ -48,7 +51,8 @@ def plot(spec, path):
     top = max(compute.values())
     x_lo = min([0.05] + [0.3 * i for i in intensities])
     x_hi = max([100.0] + [3 * i for i in intensities])
-    y_lo = min([0.5] + [0.3 * k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
+    # Room below the lowest point for the legend.
+    y_lo = min([0.5] + [0.05 * k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
                         for k in kernels])
     x = np.logspace(np.log10(x_lo), np.log10(x_hi), 400)
 
@@ -65,19 +69,18 @@ def plot(spec, path):
         ax.text(x_hi / 1.1, gflops * 1.06, f"{name}: {gflops:.1f} GFLOP/s", ha="right",
                 fontsize=8)
 
+    # Points close together would hide each other's labels: the labels go in the legend.
     for i, (k, intensity) in enumerate(zip(kernels, intensities)):
         gflops = k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
         limit, limit_name = bound(k, compute, bandwidth)
-        marker = "os^Dv"[i % 5]
-        ax.plot(intensity, gflops, marker, color="crimson", ms=8, zorder=5)
-        ax.plot([intensity, intensity], [gflops, limit], color="crimson", lw=0.8, ls=":")
-        ax.annotate(f"{k['name']}\n{k['node_steps_per_second']:.2e} node-steps/s, "
-                    f"{gflops:.2f} GFLOP/s\n{gflops / limit:.1%} of its bound "
-                    f"({limit:.1f} GFLOP/s, {limit_name})\n"
-                    f"{k['flops_per_node_step']:.0f} flops, {k['bytes_per_node_step']:.0f} B "
-                    f"per node-step",
-                    (intensity, gflops), xytext=(12, -12 - 44 * i), textcoords="offset points",
-                    fontsize=8, color="crimson", va="top")
+        color = f"C{(i + 3) % 10}"
+        ax.plot([intensity, intensity], [gflops, limit], color=color, lw=0.8, ls=":")
+        ax.plot(intensity, gflops, "os^Dv"[i % 5], color=color, ms=8, zorder=5,
+                label=f"{k['name']}: {k['node_steps_per_second']:.2e} node-steps/s, "
+                      f"{gflops:.2f} GFLOP/s,\n{gflops / limit:.1%} of its bound ({limit:.1f} "
+                      f"GFLOP/s, {limit_name}); {k['flops_per_node_step']:.0f} flops, "
+                      f"{k['bytes_per_node_step']:.0f} B per node-step")
+    ax.legend(loc="lower right", fontsize=7.5, framealpha=0.9)
 
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -88,17 +91,20 @@ def plot(spec, path):
     ax.set_title(spec.get("title", "roofline"))
     ax.grid(True, which="both", lw=0.3, alpha=0.5)
     if spec.get("note"):
-        fig.text(0.01, 0.005, spec["note"], fontsize=7, va="bottom")
-    fig.tight_layout(rect=(0, 0.03, 1, 1))
+        fig.text(0.01, 0.005, textwrap.fill(spec["note"], 150), fontsize=7, va="bottom")
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
     fig.savefig(path, dpi=130)
 
 
 def main():
-    if len(sys.argv) != 3:
+    if len(sys.argv) < 3:
         sys.exit(__doc__)
-    with open(sys.argv[1]) as f:
-        spec = json.load(f)
-    plot(spec, sys.argv[2])
+    specs = []
+    for path in sys.argv[1:-1]:
+        with open(path) as f:
+            specs.append(json.load(f))
+    spec = dict(specs[0], kernels=[k for s in specs for k in s["kernels"]])
+    plot(spec, sys.argv[-1])
 
 
 if __name__ == "__main__":
