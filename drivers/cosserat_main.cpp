@@ -169,7 +169,7 @@ std::string describe(const cosserat::Instability& failure) {
 bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, int rank) {
   MPI_Comm node;
   MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
-  const double mine = cosserat::Simulation::memory_bytes(block, scene.integrator);
+  const double mine = cosserat::Simulation::memory_bytes(block, scene.integrator, scene.discretisation);
   double needed = 0.0;
   MPI_Allreduce(&mine, &needed, 1, MPI_DOUBLE, MPI_SUM, node);
   int node_rank = 0;

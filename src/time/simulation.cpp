@@ -1,5 +1,7 @@
 #include "cosserat/time/simulation.hpp"
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -91,21 +93,24 @@ ContactSummary Simulation::contact_summary() const {
   return contact_action_ ? contact_action_->summary() : ContactSummary{};
 }
 
-double Simulation::memory_bytes(const Block& block, Integrator integrator) {
+double Simulation::memory_bytes(const Block& block, Integrator integrator,
+                                Discretisation discretisation) {
   const double ghosted_nodes = static_cast<double>(block.local_size());
   const double owned_nodes = static_cast<double>(block.owned_k()) * block.owned_l();
   // rk4 keeps nine position-sized fields (state and new state of r and v, acceleration, two
   // stages, two weighted sums), and a fluid one more for the normals.
-  // The force kernel's intermediates: the flux form's resultants and tractions, or the energy
-  // form's nine-node gradients, whichever is larger.
-  const double kernel = std::max(sizeof(NodeResultants) + 2 * sizeof(Vec3),
-                                 sizeof(CosseratEnergy::StencilGradient));
+  // The force kernel's intermediates: the flux form's resultants and tractions per node; the
+  // energy form keeps only row buffers, 36 rows of doubles a thread (docs/kernel.md).
+  const double kernel = discretisation == Discretisation::flux
+                            ? static_cast<double>(sizeof(NodeResultants) + 2 * sizeof(Vec3))
+                            : 0.0;
+  const double row_buffers = 36.0 * sizeof(double) * (block.stride() + 16) * omp_get_max_threads();
   const double per_node = kernel + 10 * sizeof(Vec3);
   const double output_buffer = 3.0 * sizeof(double) * owned_nodes;
   // 3 rows of 75 entries per node, the colouring's index of every entry, PETSc's vectors:
   // measured 13 KB per node (peak RSS 578 MB against Verlet's 59 MB on 200 x 200).
   const double baseline = integrator == Integrator::semi_implicit ? 13.5e3 * owned_nodes : 0.0;
-  return ghosted_nodes * per_node + output_buffer + baseline;
+  return ghosted_nodes * per_node + row_buffers + output_buffer + baseline;
 }
 
 Diagnostics Simulation::diagnostics() {

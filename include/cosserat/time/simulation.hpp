@@ -48,7 +48,8 @@ class Simulation {
   // Upper bound of the memory one rank's block takes: every field of the most demanding
   // explicit scheme, the force kernel's intermediates and the output buffer, and for the
   // semi-implicit one its PETSc matrix and colouring.
-  static double memory_bytes(const Block& block, Integrator integrator);
+  static double memory_bytes(const Block& block, Integrator integrator,
+                             Discretisation discretisation);
 
   std::optional<Instability> step() { return stepper_.step(); }
   long step_index() const { return stepper_.step_index(); }
