@@ -465,6 +465,8 @@ int stable_dt(const StableDtOptions& options, int rank) {
       scenes.push_back(load_scene(options.scene_path, overrides));
     }
     decomposition = Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
+    if (rank == 0)
+      for (const std::string& warning : base.warnings) fmt::print(stderr, "warning: {}\n", warning);
   });
   if (status) return *status;
   set_threads(*decomposition, options.threads, rank);

@@ -554,6 +554,29 @@ TEST_F(Cli, OutputThatIsNotARegularFileIsBadInput) {
 }
 
 
+// The complaint: a preset given on the command line to a scene with its own material changed
+// nothing, silently. Now one warning, from rank 0 alone, names the keys that override it and
+// where each is; the whole table replaced by the preset gives none.
+TEST_F(Cli, PresetOverriddenByTheSceneIsWarnedOnce) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = shell("timeout 120 " + on_ranks(2, "run " + scene +
+                                                         " -q --set material.preset=silk "
+                                                         "--set time.steps=10 -o " +
+                                                         path("x.h5")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string expected =
+      "warning: " + scene + " (from --set): key 'material.preset': preset \"silk\" is "
+      "overridden by material.mass (" + scene + ":6), material.zeta (" + scene +
+      ":7), material.xi (" + scene + ":8), material.phi (" + scene +
+      ":9), so the preset changes nothing";
+  EXPECT_THAT(r.output, HasSubstr(expected));
+  EXPECT_EQ(r.output.find("is overridden by"), r.output.rfind("is overridden by")) << r.output;
+  const Result whole = cosserat("run " + scene + " -q --set 'material={preset=\"silk\"}' " +
+                                "--set time.steps=10 -o " + path("y.h5"));
+  ASSERT_EQ(whole.status, 0) << whole.output;
+  EXPECT_THAT(whole.output, Not(HasSubstr("warning")));
+}
+
 std::string fmt_run(const std::string& scene, double dt, long steps, const std::string& output) {
   std::ostringstream command;
   command.precision(17);

@@ -96,7 +96,7 @@ TEST(Fold, SheetOverAHeldLineRunsThrough) {
 // only takes energy out, the discretisation feeds none in.
 TEST(HardCases, SilkCapeHoldsInTheEnergyForm) {
   Scene scene = load_scene(scene_file("s2_cape.toml"),
-                           {"material={preset=\"silk\"}", "model.discretisation=\"energy\""});
+                           {"material={preset=\"silk-10m\"}", "model.discretisation=\"energy\""});
   Simulation sim(scene, MPI_COMM_SELF);
   auto total = [&] {
     const Diagnostics d = sim.diagnostics();
