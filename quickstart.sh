@@ -65,8 +65,9 @@ case "${1:-}" in
   demo)
     install_missing
     build
+    # The demo may be run again: it replaces its own files.
     "$BUILD_DIR/cosserat" run scenes/s1_clothesline.toml --output s1_clothesline.h5 \
-      --summary s1_clothesline.json
+      --summary s1_clothesline.json --overwrite
     /usr/bin/python3 tools/render.py s1_clothesline.h5 --output s1_clothesline.png
     echo "wrote s1_clothesline.h5 (+ .xmf for ParaView), s1_clothesline.json, s1_clothesline.png"
     ;;

@@ -28,7 +28,7 @@ for layout in 1x1 1x2 2x1; do
       mpirun -np "$ranks" --map-by "slot:PE=$threads" --bind-to core \
       build/release/cosserat run scenes/s1_clothesline.toml -q \
       --set "grid.nodes=[$nodes,$nodes]" --set "time.dt=$dt" --set "time.steps=$steps" \
-      --set "time.output_every=$steps" -o "$work/run.h5" \
+      --set "time.output_every=$steps" -o "$work/run.h5" --overwrite \
       --summary "$work/$layout-$repeat.json"
   done
 done
