@@ -15,8 +15,8 @@ source benchmarks/context.sh decomposition release cosserat
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# The step S1's Verlet survives on this grid: the stable step shrinks with h² (MODEL.md §4.2);
-# 0.02 h² is well inside it. One frame at the start and one at the end.
+# The step S1's Verlet survives on this grid: the stable step shrinks with h² (docs/equations.md
+# §4.2); 0.02 h² is well inside it. One frame at the start and one at the end.
 dt=$(/usr/bin/python3 -c "print(0.02 * (10.0 / ($nodes - 1)) ** 2)")
 for layout in 1x1 1x2 2x1; do
   ranks=${layout%x*}

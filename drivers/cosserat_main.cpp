@@ -618,7 +618,7 @@ int main(int argc, char** argv) {
   CLI::App* stable_command = app.add_subcommand(
       "stable-dt",
       "Largest stable time step of a scene per integrator, by bisection on the stability "
-      "monitor (MODEL.md §4.2), beside the CFL estimate from the model's wave speeds");
+      "monitor (docs/stability.md), beside the CFL estimate from the model's wave speeds");
   stable_command->add_option("scene", stable.scene_path, "Scene file (TOML)")->required();
   stable_command->add_option("--integrator", stable.integrators,
                              "Integrator to test (repeatable; \"all\" for every one; default: "

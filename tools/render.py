@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Render one frame of a cosserat output file (shared/spec/SCENE_FORMAT.md, "Output") to a PNG.
+"""Render one frame of a cosserat output file (docs/output.md) to a PNG.
 
     render.py FILE.h5 [--frame N] [--output PNG] [--elev E --azim A] [--title T] [--mesh]
 
