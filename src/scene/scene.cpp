@@ -172,8 +172,10 @@ void warn_of_overridden_preset(const Table& material, const Entry& preset, Scene
   for (const std::string_view name : {"mass", "density", "zeta", "xi", "phi"})
     if (const auto given = material.find(name)) {
       overriding.push_back(fmt::format("{} ({})", given->key(), given->where()));
-      if (name == "mass" || name == "density") mass = true;
-      else ++tensors;
+      if (name == "mass" || name == "density")
+        mass = true;
+      else
+        ++tensors;
     }
   if (overriding.empty()) return;
   const std::string name = preset.string();
