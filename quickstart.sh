@@ -71,9 +71,10 @@ case "${1:-}" in
     # keeps the run and the pictures under a minute on two cores. One thread: a 60 x 60 sheet's
     # step is too short to share, and where other work holds the cores, threads waiting at each
     # step's barriers cost far more than they save (these 11000 steps on a 2-core VM with load
-    # average 6: 8-11 s on one thread, 55-77 s on two).
+    # average 6: 8-11 s on one thread, 55-77 s on two). The demo may be run again: it replaces
+    # its own files.
     "$BUILD_DIR/cosserat" run scenes/s6_compression.toml --set time.steps=11000 --threads 1 \
-      --output s6_compression.h5 --summary s6_compression.json
+      --output s6_compression.h5 --summary s6_compression.json --overwrite
     /usr/bin/python3 tools/render.py s6_compression.h5 --output s6_compression.png \
       --animate s6_compression.mp4
     echo "wrote s6_compression.h5 (+ .xmf for ParaView), s6_compression.json," \

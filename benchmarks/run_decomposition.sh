@@ -15,8 +15,8 @@ source benchmarks/context.sh decomposition release cosserat
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-# The step S1's Verlet survives on this grid: the stable step shrinks with h² (MODEL.md §4.2);
-# 0.02 h² is well inside it. One frame at the start and one at the end.
+# The step S1's Verlet survives on this grid: the stable step shrinks with h² (docs/equations.md
+# §4.2); 0.02 h² is well inside it. One frame at the start and one at the end.
 dt=$(/usr/bin/python3 -c "print(0.02 * (10.0 / ($nodes - 1)) ** 2)")
 for layout in 1x1 1x2 2x1; do
   ranks=${layout%x*}
@@ -28,7 +28,7 @@ for layout in 1x1 1x2 2x1; do
       mpirun -np "$ranks" --map-by "slot:PE=$threads" --bind-to core \
       build/release/cosserat run scenes/s1_clothesline.toml -q \
       --set "grid.nodes=[$nodes,$nodes]" --set "time.dt=$dt" --set "time.steps=$steps" \
-      --set "time.output_every=$steps" -o "$work/run.h5" \
+      --set "time.output_every=$steps" -o "$work/run.h5" --overwrite \
       --summary "$work/$layout-$repeat.json"
   done
 done

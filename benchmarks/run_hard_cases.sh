@@ -38,8 +38,8 @@ start=$(date +%s)
 
 # label|scene|steps (full run)|extra --set (one, may be empty)
 cases=()
-for p in silk cotton denim canvas satin linen velvet coated-cotton sheer-curtain heavy-curtain \
-  shower-curtain flag; do
+for p in silk-10m cotton-10m denim-10m canvas-10m satin-10m linen-10m velvet-10m \
+  coated-cotton-10m sheer-curtain-10m heavy-curtain-10m shower-curtain-10m flag-10m; do
   cases+=("S2 $p|scenes/s2_cape.toml|10000|material={preset=\"$p\"}")
 done
 for s in silk_square cotton_square denim_square s6_loads_x5 s6_xi0 s4_flag_preset crumple; do

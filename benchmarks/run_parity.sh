@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# Parity of the energy form (model.discretisation = "energy", MODEL.md §2.5) with the flux form
-# (issue 11, item 6, and item 1's node-steps/s): the largest stable Verlet Δt of S1-S6 per form,
-# a refinement study of an S1-like sheet on nested grids (10, 19, 37, 73, 145 nodes a side; S1's
-# corner supports, edge segments of fixed length, and those undamped) with
-# the distance between the forms and each form's self-convergence, and node-steps/s of both
-# forms on a 1024 x 1024 sheet with 1 and 2 threads. Writes
+# Parity of the energy form (model.discretisation = "energy", docs/equations.md §2.5) with the
+# flux form (issue 11, item 6, and item 1's node-steps/s): the largest stable Verlet Δt of S1-S6
+# per form, a refinement study of an S1-like sheet on nested grids (10, 19, 37, 73, 145 nodes a
+# side; S1's corner supports, edge segments of fixed length, and those undamped) with the
+# distance between the forms and each form's self-convergence, and node-steps/s of both forms on
+# a 1024 x 1024 sheet with 1 and 2 threads. Writes
 # benchmarks/results/parity-<host>-<date>{.md,-stability.csv,-refinement.csv,
-# -refinement-runs.csv,-throughput.csv,-refinement.png,.log}. About 17 min on the 2-core VM (measured under load 4-9);
-# --parts stability,refinement,throughput runs a part (its CSV is replaced, the report redone).
-# The binary: $COSSERAT if set (no build), else the release build made here.
+# -refinement-runs.csv,-throughput.csv,-refinement.png,.log}. About 17 min on the 2-core VM
+# (measured under load 4-9); --parts stability,refinement,throughput runs a part (its CSV is
+# replaced, the report redone). The binary: $COSSERAT if set (no build), else the release build
+# made here.
 #   [COSSERAT=path/to/cosserat] benchmarks/run_parity.sh [tools/parity_study.py options]
 set -euo pipefail
 cd "$(dirname "$0")/.."

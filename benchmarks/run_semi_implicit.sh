@@ -27,7 +27,7 @@ solvers=("gmres bjacobi" "gmres jacobi" "gmres sor" "gmres none" "gmres gamg" "b
     IFS='|' read -r label scene dt steps <<<"$case"
     for solver in "${solvers[@]}"; do
       read -r ksp pc <<<"$solver"
-      build/release/cosserat run "$scene" -q -o "$work/o.h5" --summary "$work/s.json" \
+      build/release/cosserat run "$scene" -q --overwrite -o "$work/o.h5" --summary "$work/s.json" \
         --set time.integrator='"semi-implicit"' --set time.dt="$dt" --set time.steps="$steps" \
         --set time.output_every="$steps" --set time.solver.ksp="\"$ksp\"" \
         --set time.solver.pc="\"$pc\"" >/dev/null 2>&1 || true
@@ -39,7 +39,7 @@ print(f"| {label} | {dt} | {ksp} | {pc} | {l['mean_iterations']:.2f} ({l['most_i
       f"{l['jacobian_seconds'] / n:.2e} | {(l['solve_seconds']) / n:.2e} | {s['status']} |")
 PY
     done
-    build/release/cosserat run "$scene" -q -o "$work/o.h5" --summary "$work/s.json" \
+    build/release/cosserat run "$scene" -q --overwrite -o "$work/o.h5" --summary "$work/s.json" \
       --set time.dt=0.001 --set time.steps=2000 --set time.output_every=2000 >/dev/null 2>&1
     /usr/bin/python3 -c "
 import json; s = json.load(open('$work/s.json'))

@@ -53,8 +53,9 @@ def command(cosserat, ranks, output, restart):
             "run", SCENE, "-q", "-o", output, "--checkpoint-every", str(CHECKPOINT_EVERY)]
     for o in OVERRIDES:
         line += ["--set", o]
-    if restart:
-        line += ["--restart", restart]
+    # A segment without a checkpoint to restart from starts the output over, as a user would
+    # after a kill before the first checkpoint.
+    line += ["--restart", restart] if restart else ["--overwrite"]
     return line
 
 

@@ -55,6 +55,7 @@ struct RunOptions {
   std::optional<double> until_rest;
   std::optional<int> threads;
   bool quiet = false;
+  bool overwrite = false;
 };
 
 struct StableDtOptions {
@@ -221,8 +222,9 @@ std::optional<int> bad_input(const std::string& scene_path, int rank, Work&& wor
 
 // The files a run will write, checked before any work (DESIGN.md principle 6): none may be the
 // scene, the checkpoint it restarts from (but its own checkpoint, which a restart continues) or
-// another of them; each must be a plain file in a folder that takes one. Returns what is wrong,
-// or nothing.
+// another of them; each must be a plain file in a folder that takes one; none may hold an
+// earlier run's results unless the run is told to overwrite them or restarts. Returns what is
+// wrong, or nothing.
 std::optional<std::string> output_conflict(const RunOptions& options, const std::string& output) {
   namespace fs = std::filesystem;
   struct Named {
@@ -261,6 +263,23 @@ std::optional<std::string> output_conflict(const RunOptions& options, const std:
       if (same(written[i].path, written[j].path))
         return fmt::format("{} and {} would be the same file ({}); name another",
                            written[j].what, written[i].what, written[i].path);
+  }
+  // An earlier run's results are not replaced unasked. A restart continues its own output (and
+  // writes its XDMF file, checkpoint and summary again); an empty file holds nothing to lose (a
+  // run killed between taking its lock and creating the HDF5 file leaves one).
+  if (options.overwrite || !options.restart.empty()) return std::nullopt;
+  for (const Named& file : written) {
+    std::error_code error;
+    if (!fs::exists(file.path, error) || fs::file_size(file.path, error) == 0) continue;
+    const std::string checkpoint = cosserat::checkpoint_path(output);
+    const std::string restart =
+        fs::exists(checkpoint, error)
+            ? fmt::format(", or continue that run with --restart {}", checkpoint)
+            : "";
+    return fmt::format(
+        "{} ({}) exists, from an earlier run; pass --overwrite to replace it, or name another "
+        "{}{}",
+        file.what, file.path, file.what == "--summary" ? "--summary" : "--output", restart);
   }
   return std::nullopt;
 }
@@ -465,6 +484,8 @@ int stable_dt(const StableDtOptions& options, int rank) {
       scenes.push_back(load_scene(options.scene_path, overrides));
     }
     decomposition = Decomposition::choose(base.m, base.n, size_of(MPI_COMM_WORLD));
+    if (rank == 0)
+      for (const std::string& warning : base.warnings) fmt::print(stderr, "warning: {}\n", warning);
   });
   if (status) return *status;
   set_threads(*decomposition, options.threads, rank);
@@ -579,6 +600,10 @@ int main(int argc, char** argv) {
                           "cores this rank may run on, shared with the ranks of its node given "
                           "the same cores, and at most its block's rows)")
       ->check(CLI::Range(1, 4096));
+  run_command->add_flag("--overwrite", options.overwrite,
+                        "Replace the output files (HDF5, XDMF, checkpoint, summary) when they "
+                        "exist; without it a run whose output files exist exits with status 2 "
+                        "before any work (a --restart continues its output and needs no flag)");
   run_command->add_flag("-q,--quiet", options.quiet,
                         "Print nothing but warnings and errors (the progress line is shown "
                         "only on a terminal anyway)");
@@ -593,7 +618,7 @@ int main(int argc, char** argv) {
   CLI::App* stable_command = app.add_subcommand(
       "stable-dt",
       "Largest stable time step of a scene per integrator, by bisection on the stability "
-      "monitor (MODEL.md §4.2), beside the CFL estimate from the model's wave speeds");
+      "monitor (docs/stability.md), beside the CFL estimate from the model's wave speeds");
   stable_command->add_option("scene", stable.scene_path, "Scene file (TOML)")->required();
   stable_command->add_option("--integrator", stable.integrators,
                              "Integrator to test (repeatable; \"all\" for every one; default: "

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Writes an S1-like scene (SCENES.md S1: the 10 m x 10 m, 10 kg reference sheet hung from the
+# Writes an S1-like scene (docs/scenes.md S1: the 10 m x 10 m, 10 kg reference sheet hung from the
 # two corners of one edge, gravity, damping 0.2, Verlet) on a NODES x NODES grid to FILE.
 # S1's own file names its corners by index for its 10 x 10 grid; here they follow NODES. The
 # step is 0.02 h²: on fine grids bending sets the largest stable Verlet step, which shrinks

@@ -3,10 +3,11 @@
 #   jobs/mpirun_large_sheet.sh RANKS THREADS [NODES=4096] [STEPS=1000] [OUTDIR=runs]
 # Writes OUTDIR/sheet<NODES>-<RANKS>x<THREADS>.{toml,h5,xmf,json} (the run summary beside the
 # output) and a checkpoint every STEPS/10 steps; run it again with RESUME=1 to continue from
-# the checkpoint after a kill.
+# the checkpoint after a kill (or to start over when the kill came before the first one), or with
+# OVERWRITE=1 to replace the files of an earlier run, which a run otherwise refuses to.
 set -euo pipefail
 if [[ $# -lt 2 ]]; then
-  sed -n '2,6p' "$0"
+  sed -n '2,7p' "$0"
   exit 2
 fi
 ranks=$1
@@ -25,7 +26,11 @@ stem=$outdir/sheet$nodes-${ranks}x$threads
 "$here/make_large_sheet.sh" "$nodes" "$steps" "$stem.toml"
 
 restart=()
-if [[ ${RESUME:-0} == 1 && -f $stem.checkpoint.h5 ]]; then restart=(--restart "$stem.checkpoint.h5"); fi
+if [[ ${RESUME:-0} == 1 ]]; then
+  if [[ -f $stem.checkpoint.h5 ]]; then restart=(--restart "$stem.checkpoint.h5"); else restart=(--overwrite); fi
+elif [[ ${OVERWRITE:-0} == 1 ]]; then
+  restart=(--overwrite)
+fi
 root=()
 if [[ $(id -u) == 0 ]]; then root=(--allow-run-as-root); fi
 # One rank per THREADS cores, its threads kept on them.

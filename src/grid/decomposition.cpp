@@ -39,7 +39,7 @@ Decomposition Decomposition::with_parts(int m, int n, int parts_k, int parts_l) 
   if (!fits(m, parts_k) || !fits(n, parts_l))
     throw DecompositionError(fmt::format(
         "grid {} x {} split into {} x {} blocks leaves a block narrower than {} nodes, the "
-        "ghost width of the stencil (MODEL.md §2.4)",
+        "ghost width of the stencil (docs/parallel.md)",
         m, n, parts_k, parts_l, kGhostWidth));
   return Decomposition(m, n, parts_k, parts_l);
 }
@@ -60,7 +60,7 @@ Decomposition Decomposition::choose(int m, int n, int ranks) {
   if (!best)
     throw DecompositionError(fmt::format(
         "grid {} x {} cannot be split over {} MPI ranks: every split leaves a block narrower "
-        "than {} nodes, the ghost width of the stencil (MODEL.md §2.4); use fewer ranks",
+        "than {} nodes, the ghost width of the stencil (docs/parallel.md); use fewer ranks",
         m, n, ranks, kGhostWidth));
   return *best;
 }

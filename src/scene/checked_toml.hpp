@@ -50,6 +50,10 @@ class Entry {
 
   [[noreturn]] void fail(std::string_view what) const { origin_->fail(node_, key_, what); }
 
+  const std::string& key() const { return key_; }
+  // "file:line", or "file (from --set)": for a warning about this value.
+  std::string where() const { return origin_->locate(node_); }
+
   // Integers are accepted where numbers are expected; inf and nan never are.
   double number() const;
   long integer() const;

@@ -140,15 +140,15 @@ Preset preset_named(const Entry& entry) {
 
 enum class Bound { positive, non_negative, any };
 
-// zeta, xi or phi: from the table when given, else isotropic from the preset, else required.
+// zeta, xi or phi: from the table when given, else from the preset, else required.
 Sym2 material_tensor(const Table& material, std::string_view name,
-                     std::optional<double> from_preset, Bound bound) {
+                     std::optional<Sym2> from_preset, Bound bound) {
   const auto given = material.find(name);
   if (!given) {
     if (!from_preset) {
       material.missing(name, "a number or an array of 3 numbers [t11, t12, t22] (or a preset)");
     }
-    return {*from_preset, *from_preset, *from_preset};
+    return *from_preset;
   }
   const Sym2 tensor = given->tensor();
   for (const double entry : tensor) {
@@ -162,14 +162,41 @@ Sym2 material_tensor(const Table& material, std::string_view name,
   return tensor;
 }
 
+// A key beside `preset` replaces the preset's value. Said out loud, because it may leave little
+// of the preset: `--set material.preset=silk` on a scene that gives every material key changes
+// nothing.
+void warn_of_overridden_preset(const Table& material, const Entry& preset, Scene& scene) {
+  std::vector<std::string> overriding;
+  bool mass = false;
+  int tensors = 0;
+  for (const std::string_view name : {"mass", "density", "zeta", "xi", "phi"})
+    if (const auto given = material.find(name)) {
+      overriding.push_back(fmt::format("{} ({})", given->key(), given->where()));
+      if (name == "mass" || name == "density")
+        mass = true;
+      else
+        ++tensors;
+    }
+  if (overriding.empty()) return;
+  const std::string name = preset.string();
+  const std::string effect = mass && tensors == 3
+                                 ? "so the preset changes nothing"
+                                 : "which keep their own values; the preset gives the rest";
+  scene.warnings.push_back(fmt::format(
+      "{}: key '{}': preset \"{}\" is overridden by {}, {} (to take the preset whole, remove "
+      "them, or --set material={{preset=\"{}\"}})",
+      preset.where(), preset.key(), name, joined(overriding), effect, name));
+}
+
 void read_material(const Table& material, Scene& scene) {
   material.allow({"preset", "mass", "density", "zeta", "xi", "phi"});
   const double area = scene.size1 * scene.size2;
 
   std::optional<Preset> preset;
-  if (const auto entry = material.find("preset")) preset = preset_named(*entry);
-  auto preset_value = [&](double Preset::*member) {
-    return preset ? std::optional<double>((*preset).*member) : std::nullopt;
+  const auto preset_entry = material.find("preset");
+  if (preset_entry) preset = preset_named(*preset_entry);
+  auto preset_value = [&](Sym2 Preset::*member) {
+    return preset ? std::optional<Sym2>((*preset).*member) : std::nullopt;
   };
   scene.material.zeta =
       material_tensor(material, "zeta", preset_value(&Preset::zeta), Bound::positive);
@@ -190,11 +217,12 @@ void read_material(const Table& material, Scene& scene) {
           fmt::format("density x area = {} x {} m^2 is not a finite mass", areal, area));
     scene.material.mass = areal * area;
   } else if (preset) {
-    // Preset masses are for a 10 m x 10 m sheet (SCENES.md): keep the areal density.
-    scene.material.mass = preset->mass_10x10 * area / 100.0;
+    // A preset is a fabric, the same at any size: its areal density is kept.
+    scene.material.mass = preset->mass * area / preset->area;
   } else {
     material.missing("mass", "mass (total kg) or density (kg/m^2), exactly one (or a preset)");
   }
+  if (preset) warn_of_overridden_preset(material, *preset_entry, scene);
 }
 
 void read_model(const Table& model, Scene& scene) {
@@ -607,7 +635,7 @@ void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
       scene.energy_indefinite = true;
       scene.warnings.push_back(fmt::format(
           "{}: material component {}: phi^2 = {} >= 4 zeta xi = {}, so the stored energy is not "
-          "positive definite (MODEL.md §1); raise xi or lower phi",
+          "positive definite (docs/materials.md); raise xi or lower phi",
           origin.path(), components[i], coupling, bound));
     }
   }

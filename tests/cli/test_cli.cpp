@@ -95,7 +95,7 @@ TEST_F(Cli, HelpDocumentsEveryOption) {
   const Result run = cosserat("run --help");
   EXPECT_EQ(run.status, 0);
   for (const char* option : {"--set", "--output", "--summary", "--quiet", "--checkpoint-every",
-                             "--restart", "--until-rest", "--petsc", "--threads"})
+                             "--restart", "--until-rest", "--petsc", "--threads", "--overwrite"})
     EXPECT_THAT(run.output, HasSubstr(option));
   const Result stable = cosserat("stable-dt --help");
   EXPECT_EQ(stable.status, 0);
@@ -413,13 +413,14 @@ TEST_F(Cli, ErrorOnOneRankEndsEveryRank) {
 // rank and on two (both ranks end promptly; the timeout turns a hang into a failure), with exit
 // status 2 and a message naming the file, and the first run's file is left alone. The lock dies
 // with its process: after the first run is killed, a new run on the same output goes ahead.
-// Before, both runs wrote the file, exited 0 and left it unreadable.
+// Before, both runs wrote the file, exited 0 and left it unreadable. The later runs pass
+// --overwrite: the lock, not the output's existing, is what refuses the second.
 TEST_F(Cli, SecondRunOnAnOutputBeingWrittenIsRefused) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   const std::string first = std::string(COSSERAT_EXE) + " run " + scene +
                             " --set grid.nodes=[30,30] --set time.steps=200000 "
                             "--set time.output_every=500 -q -o " + path("out.h5");
-  const std::string second = "run " + scene + " -q -o " + path("out.h5");
+  const std::string second = "run " + scene + " -q --overwrite -o " + path("out.h5");
   const Result r = shell(
       "sh -c '" + first + " & pid=$!; until grep -qs frame_1 " + path("out.xmf") +
       "; do sleep 0.01; done; " + COSSERAT_EXE + " " + second + "; echo second $?; timeout 60 " +
@@ -473,7 +474,7 @@ TEST_F(Cli, RanksSharingTheirCoresSplitThem) {
 TEST_F(Cli, ExplicitThreadCountWinsWithAWarningWhenCoresAreShort) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   const int more = cores_of_this_process() + 1;
-  const std::string run = "run " + scene + " --set time.steps=10 -o " + path("o.h5") +
+  const std::string run = "run " + scene + " --set time.steps=10 --overwrite -o " + path("o.h5") +
                           " --summary " + path("s.json");
   const Result from_environment =
       shell("OMP_NUM_THREADS=" + std::to_string(more) + " " + COSSERAT_EXE + " " + run);
@@ -516,7 +517,7 @@ TEST_F(Cli, CorruptCheckpointIsBadInputOnEveryRank) {
   };
   const auto checkpoint_at_step_10 = [&] {
     const Result first = shell(on_ranks(2, "run " + scene + " -q --set time.steps=10 "
-                                           "--checkpoint-every 10 -o " + path("a.h5")));
+                                           "--checkpoint-every 10 --overwrite -o " + path("a.h5")));
     ASSERT_EQ(first.status, 0) << first.output;
   };
   checkpoint_at_step_10();
@@ -553,6 +554,112 @@ TEST_F(Cli, OutputThatIsNotARegularFileIsBadInput) {
   EXPECT_FALSE(fs::exists(path("out.h5")));
 }
 
+
+// The complaint: a preset given on the command line to a scene with its own material changed
+// nothing, silently. Now one warning, from rank 0 alone, names the keys that override it and
+// where each is; the whole table replaced by the preset gives none.
+TEST_F(Cli, PresetOverriddenByTheSceneIsWarnedOnce) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = shell("timeout 120 " + on_ranks(2, "run " + scene +
+                                                         " -q --set material.preset=silk "
+                                                         "--set time.steps=10 -o " +
+                                                         path("x.h5")));
+  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string expected =
+      "warning: " + scene + " (from --set): key 'material.preset': preset \"silk\" is "
+      "overridden by material.mass (" + scene + ":6), material.zeta (" + scene +
+      ":7), material.xi (" + scene + ":8), material.phi (" + scene +
+      ":9), so the preset changes nothing";
+  EXPECT_THAT(r.output, HasSubstr(expected));
+  EXPECT_EQ(r.output.find("is overridden by"), r.output.rfind("is overridden by")) << r.output;
+  const Result whole = cosserat("run " + scene + " -q --set 'material={preset=\"silk\"}' " +
+                                "--set time.steps=10 -o " + path("y.h5"));
+  ASSERT_EQ(whole.status, 0) << whole.output;
+  EXPECT_THAT(whole.output, Not(HasSubstr("warning")));
+}
+
+// The bytes of a file, for "left untouched".
+std::string file_bytes(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A second run into the files of the first is bad input before any work, naming the file and
+// the way out, and leaves every file as it was: the default output, an -o output, its XDMF file,
+// its checkpoint, its summary. --overwrite replaces them. Before, the second run wrote over the
+// first's results without a word.
+TEST_F(Cli, ExistingOutputIsNotReplacedUnasked) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string in_dir = "cd " + dir_.string() + " && " + COSSERAT_EXE + " run s.toml -q";
+  ASSERT_EQ(shell(in_dir).status, 0);
+  const std::string first = file_bytes(path("s.h5"));
+  const Result again = shell(in_dir);
+  EXPECT_EQ(again.status, 2) << again.output;
+  EXPECT_THAT(again.output, HasSubstr("--output (s.h5) exists, from an earlier run; pass "
+                                      "--overwrite to replace it"));
+  EXPECT_EQ(file_bytes(path("s.h5")), first);
+
+  const std::string run = "run " + scene + " -q --set time.steps=100 -o " + path("o.h5") +
+                          " --summary " + path("o.json") + " --checkpoint-every 50";
+  ASSERT_EQ(cosserat(run).status, 0);
+  const std::string output = file_bytes(path("o.h5")), xdmf = file_bytes(path("o.xmf")),
+                    checkpoint = file_bytes(path("o.checkpoint.h5")),
+                    summary = file_bytes(path("o.json"));
+  const Result second = cosserat(run);
+  EXPECT_EQ(second.status, 2) << second.output;
+  EXPECT_THAT(second.output, HasSubstr(path("o.h5") + ") exists"));
+  EXPECT_THAT(second.output, HasSubstr("--restart " + path("o.checkpoint.h5")));
+  EXPECT_EQ(file_bytes(path("o.h5")), output);
+  EXPECT_EQ(file_bytes(path("o.xmf")), xdmf);
+  EXPECT_EQ(file_bytes(path("o.checkpoint.h5")), checkpoint);
+  EXPECT_EQ(file_bytes(path("o.json")), summary);
+
+  // Each file on its own is enough to refuse: an XDMF file, a checkpoint, a summary.
+  for (const std::string kept : {"o.h5", "o.json"}) fs::remove(path(kept));
+  const Result xdmf_only = cosserat(run);
+  EXPECT_EQ(xdmf_only.status, 2) << xdmf_only.output;
+  EXPECT_THAT(xdmf_only.output, HasSubstr("the XDMF file (" + path("o.xmf") + ") exists"));
+  fs::remove(path("o.xmf"));
+  EXPECT_THAT(cosserat(run).output, HasSubstr("the checkpoint (" + path("o.checkpoint.h5") + ") exists"));
+  fs::remove(path("o.checkpoint.h5"));
+  ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=10 -o " + path("p.h5") +
+                     " --summary " + path("o.json"))
+                .status,
+            0);
+  const Result summary_only = cosserat(run);
+  EXPECT_EQ(summary_only.status, 2) << summary_only.output;
+  EXPECT_THAT(summary_only.output,
+              HasSubstr("--summary (" + path("o.json") + ") exists, from an earlier run; pass "
+                        "--overwrite to replace it, or name another --summary"));
+
+  // With --overwrite the run goes ahead and replaces them all.
+  const Result replaced = cosserat(run + " --overwrite --set time.steps=50");
+  ASSERT_EQ(replaced.status, 0) << replaced.output;
+  EXPECT_EQ(read_frames(path("o.h5")).first, 2);  // steps 0 and 50
+  EXPECT_THAT(file_bytes(path("o.json")), HasSubstr("\"steps\": 50"));
+}
+
+// A restart is the run that continues its output: it needs no --overwrite, and replaces the
+// XDMF file, the checkpoint and the summary of the run it continues. An empty output (left by a
+// run killed before its file was created) holds nothing and is no obstacle.
+TEST_F(Cli, RestartAndEmptyOutputNeedNoOverwrite) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=120 --checkpoint-every 50 -o " +
+                     path("part.h5") + " --summary " + path("part.json"))
+                .status,
+            0);
+  const Result restarted = cosserat("run " + scene + " -q --checkpoint-every 50 --restart " +
+                                    path("part.checkpoint.h5") + " -o " + path("part.h5") +
+                                    " --summary " + path("part.json"));
+  ASSERT_EQ(restarted.status, 0) << restarted.output;
+  EXPECT_EQ(read_frames(path("part.h5")).first, 6);  // 0, 50, 100, 120, then 150 and 200
+  EXPECT_THAT(file_bytes(path("part.json")), HasSubstr("\"restarted_from\": 120"));
+
+  std::ofstream(path("empty.h5")).close();
+  const Result into_empty = cosserat("run " + scene + " -q -o " + path("empty.h5"));
+  ASSERT_EQ(into_empty.status, 0) << into_empty.output;
+  EXPECT_EQ(read_frames(path("empty.h5")).first, 5);
+}
 
 std::string fmt_run(const std::string& scene, double dt, long steps, const std::string& output) {
   std::ostringstream command;
@@ -607,7 +714,7 @@ TEST_F(Cli, StableDtBracketsTheLimitThatRunSees) {
   EXPECT_LE(unstable, 1.02 * stable);
   for (const auto& [dt, status] : {std::pair{stable, 0}, std::pair{unstable, 3}}) {
     const long steps = std::lround(std::ceil(0.5 / dt - 1e-9));
-    const Result run = cosserat(fmt_run(scene, dt, steps, path("b.h5")));
+    const Result run = cosserat(fmt_run(scene, dt, steps, path("b" + std::to_string(status) + ".h5")));
     EXPECT_EQ(run.status, status) << "dt = " << dt << "\n" << run.output;
   }
 }

@@ -25,7 +25,7 @@ u = [1.0, 0.0, 0.0]
 v = [0.0, 0.0, -1.0]
 
 [material]
-preset = "cotton"
+preset = "cotton-10m"
 phi = [0.01, 0.0, 0.01]
 
 [model]

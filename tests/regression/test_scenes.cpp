@@ -96,7 +96,7 @@ TEST(Fold, SheetOverAHeldLineRunsThrough) {
 // only takes energy out, the discretisation feeds none in.
 TEST(HardCases, SilkCapeHoldsInTheEnergyForm) {
   Scene scene = load_scene(scene_file("s2_cape.toml"),
-                           {"material={preset=\"silk\"}", "model.discretisation=\"energy\""});
+                           {"material={preset=\"silk-10m\"}", "model.discretisation=\"energy\""});
   Simulation sim(scene, MPI_COMM_SELF);
   auto total = [&] {
     const Diagnostics d = sim.diagnostics();
@@ -111,6 +111,37 @@ TEST(HardCases, SilkCapeHoldsInTheEnergyForm) {
   EXPECT_DOUBLE_EQ(sim.time(), 10.0);
   EXPECT_LE(highest, start);
   EXPECT_LT(total(), start - 100.0);  // hundreds of joules damped out of the fall
+}
+
+// A strip of scenes/fabric/tablecloth_overhang.toml (1 m along x, 5 cm across): 0.6 m held on
+// the table, 0.4 m over its edge. The real-size cotton (bending length 2 cm) hangs straight down
+// from the edge; its 10 m calibration (0.24 m) on the same strip sticks out like card
+// (docs/materials.md). Damping at a rate of 5 /s for both, so each is at rest by 3 s; the
+// calibration's softer membrane takes a step four times longer.
+TEST(RealSizeFabric, CottonHangsWhereItsTenMetreCalibrationSticksOut) {
+  const auto free_edge = [](const std::string& preset, const std::string& damping,
+                            const std::string& dt) {
+    const std::string text = "[grid]\nnodes = [41, 3]\nsize = [1.0, 0.05]\n"
+                             "origin = [0.0, 0.75, 0.0]\n[material]\npreset = \"" + preset +
+                             "\"\n[environment]\ngravity = [0.0, -9.81, 0.0]\ndamping = " +
+                             damping + "\n[time]\ndt = " + dt + "\nduration = 3.0\n"
+                             "[[fix]]\nregion = { rect = [0, 0, 24, 2] }\n";
+    const Scene scene = parse_scene(text, "strip.toml");
+    Simulation sim(scene, MPI_COMM_SELF);
+    EXPECT_TRUE(testing::advance(sim, scene.steps)) << preset << ": unstable";
+    // Of the 5-17 mJ the fall releases.
+    EXPECT_LT(sim.diagnostics().kinetic_energy, 1e-6) << preset << ": not at rest";
+    return sim.positions()(40, 1);
+  };
+  const Vec3 cotton = free_edge("cotton", "0.6", "5e-5"),
+             calibration = free_edge("cotton-10m", "4.4", "2e-4");
+  std::printf("[overhang] free edge: cotton %.4f m below the table, %.4f m out; cotton-10m "
+              "%.4f m below, %.4f m out\n",
+              0.75 - cotton.y, cotton.x - 0.6, 0.75 - calibration.y, calibration.x - 0.6);
+  EXPECT_GT(0.75 - cotton.y, 0.39);        // the whole 0.4 m hangs down
+  EXPECT_LT(std::abs(cotton.x - 0.6), 0.02);  // below the table's edge
+  EXPECT_LT(0.75 - calibration.y, 0.25);
+  EXPECT_GT(calibration.x - 0.6, 0.3);
 }
 
 }  // namespace

@@ -234,5 +234,58 @@ TEST(EnergyForm, DampedRunNeverGainsEnergy) {
   }
 }
 
+// The material constants in physical terms (docs/materials.md, "Units"), from the energy of
+// the grid itself on a flat rest sheet with u ⊥ v: a stretch e along x¹ stores 3ζ₁₁e² per unit
+// area (tension 6ζ₁₁e), a shear angle γ stores ζ₁₂γ²/2 (shear force ζ₁₂γ), a bend of curvature
+// κ stores 3ξ₁₁κ² (moment 6ξ₁₁κ, bending rigidity B = 6ξ₁₁). So ζ is in N/m, ξ in N m.
+TEST(EnergyForm, MaterialConstants) {
+  Scene s = testing::flat_sheet(51, 11);
+  s.size1 = 0.5;
+  s.size2 = 0.1;
+  s.material.zeta = {300.0, 7.0, 300.0};
+  s.material.xi = {2e-6, 2e-6, 2e-6};
+  s.material.phi = {0.0, 0.0, 0.0};
+  const double h1 = s.h1(), h2 = s.h2();
+  Sheet sheet(s);
+  // Every node carries the energy of one cell, h₁h₂ (MODEL.md §2.5); the terms of a node that
+  // lacks the forward cell or a neighbour are left out, so each count is of the nodes that have
+  // the term.
+  const auto place = [&](auto&& position) {
+    for (int l = 0; l < s.n; ++l)
+      for (int k = 0; k < s.m; ++k) sheet.r(k, l) = position(k * h1, l * h2);
+  };
+
+  const double stretch = 1.001;  // ε₁₁ = ½(λ² − 1), exactly at every node
+  place([&](double x, double z) { return Vec3{stretch * x, 0.0, z}; });
+  const double epsilon = 0.5 * (stretch * stretch - 1.0);
+  EXPECT_NEAR(sheet.total() / (s.m * s.n * h1 * h2),
+              3.0 * s.material.zeta[0] * epsilon * epsilon, 1e-12);
+
+  const double gamma = 1e-3;  // a1 · a2 = γ, a_αα = 1 + γ²/4: ε₁₂ = γ/2, ε_αα = γ²/8
+  place([&](double x, double z) { return Vec3{x + 0.5 * gamma * z, 0.0, z + 0.5 * gamma * x}; });
+  const double shear = s.material.zeta[1] * gamma * gamma / 2.0;
+  const double stretched = 2.0 * 3.0 * s.material.zeta[0] * std::pow(gamma * gamma / 8.0, 2);
+  EXPECT_NEAR(sheet.total(),
+              (s.m - 1) * (s.n - 1) * h1 * h2 * shear + s.m * s.n * h1 * h2 * stretched,
+              1e-9 * sheet.total());
+
+  // A cylinder of radius R about z, the nodes on the circle: D₁₁r is radial, of length
+  // κ = 2(1 − cos(h/R))R/h² (→ 1/R), and every tangent is a chord, shorter than h, which adds
+  // a uniform ε₁₁ = ½((2R sin(h/2R)/h)² − 1). κ₁₁ is left out on the k borders.
+  const double R = 1.0;
+  place([&](double x, double z) {
+    return Vec3{R * std::sin(x / R), R * (1.0 - std::cos(x / R)), z};
+  });
+  const double kappa = 2.0 * (1.0 - std::cos(h1 / R)) * R / (h1 * h1);
+  const double chord = 2.0 * R * std::sin(h1 / (2.0 * R)) / h1;
+  const double shortened = 0.5 * (chord * chord - 1.0);
+  const double bending = 3.0 * s.material.xi[0] * kappa * kappa;
+  EXPECT_NEAR(sheet.total(),
+              s.m * s.n * h1 * h2 * 3.0 * s.material.zeta[0] * shortened * shortened +
+                  (s.m - 2) * s.n * h1 * h2 * bending,
+              1e-9 * sheet.total());
+  EXPECT_NEAR(kappa, 1.0 / R, 1e-5);
+}
+
 }  // namespace
 }  // namespace cosserat

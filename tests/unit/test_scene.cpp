@@ -9,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <numbers>
 #include <set>
 #include <string>
 #include <utility>
@@ -21,6 +22,7 @@ namespace {
 
 using ::testing::AllOf;
 using ::testing::HasSubstr;
+using ::testing::Not;
 using ::testing::StartsWith;
 
 constexpr const char* kPath = "scenes/test.toml";
@@ -177,21 +179,94 @@ TEST(Scene, FixDefaultsHoldEveryAxisForTheWholeRun) {
 TEST(Scene, PresetGivesEverythingAndScalesMassToTheSheet) {
   SceneText text;
   text.grid = "nodes = [5, 5]\nsize = [5.0, 4.0]\n";
-  text.material = "preset = \"silk\"\n";
+  text.material = "preset = \"silk-10m\"\n";
   const Scene scene = parse(text);
-  EXPECT_DOUBLE_EQ(scene.material.mass, 78.0 * 20.0 / 100.0);
+  EXPECT_EQ(scene.material.mass, 78.0 * 20.0 / 100.0);
   EXPECT_EQ(scene.material.zeta, (Sym2{100, 100, 100}));
   EXPECT_EQ(scene.material.xi, (Sym2{0.01, 0.01, 0.01}));
   EXPECT_EQ(scene.material.phi, (Sym2{0.1, 0.1, 0.1}));
+  EXPECT_TRUE(scene.warnings.empty());
+}
+
+// A measured fabric is the same cloth on any sheet: its areal density is kept, its tensors are
+// per unit length and area and do not change with the size.
+TEST(Scene, RealSizePresetKeepsItsArealDensityAtAnySize) {
+  const Preset cotton = *find_preset("cotton");
+  EXPECT_EQ(cotton.area, 1.0);
+  EXPECT_DOUBLE_EQ(cotton.mass, 0.120);  // 120 g/m², docs/materials.md
+  for (const char* size : {"[1.0, 1.0]", "[0.4, 2.5]", "[10.0, 10.0]"}) {
+    SceneText text;
+    text.grid = std::string("nodes = [5, 5]\nsize = ") + size + "\n";
+    text.material = "preset = \"cotton\"\n";
+    const Scene scene = parse(text);
+    SCOPED_TRACE(size);
+    EXPECT_DOUBLE_EQ(scene.material.mass / (scene.size1 * scene.size2), 0.120);
+    EXPECT_EQ(scene.material.zeta, cotton.zeta);
+    EXPECT_EQ(scene.material.xi, cotton.xi);
+    EXPECT_EQ(scene.material.phi, cotton.phi);
+  }
+}
+
+// The measured presets from their KES-F numbers (docs/materials.md): ξ = B/6, ζ₁₂ = G,
+// ζ₁₁ = ζ₂₂ = K/6 with K = 500 gf/cm over EMT, each in SI; φ inside its bound.
+TEST(Scene, MeasuredPresetsFollowTheirKesNumbers) {
+  constexpr double gf = 9.80665e-3;  // N
+  const Preset cotton = *find_preset("cotton");  // B 0.10 gf cm²/cm, G 1.0 gf/(cm deg), EMT 4 %
+  EXPECT_NEAR(cotton.xi[0], 0.10 * gf * 1e-2 / 6.0, 1e-18);
+  EXPECT_EQ(cotton.xi[0], cotton.xi[1]);
+  EXPECT_EQ(cotton.xi[0], cotton.xi[2]);
+  EXPECT_NEAR(cotton.zeta[1], 1.0 * gf / 1e-2 * 180.0 / std::numbers::pi, 1e-12);
+  EXPECT_NEAR(cotton.zeta[0], 500.0 * gf / 1e-2 / 0.04 / 6.0, 1e-9);
+  EXPECT_EQ(cotton.zeta[0], cotton.zeta[2]);
+  for (const char* name : {"silk", "cotton", "linen", "wool", "polyester", "denim"}) {
+    SCOPED_TRACE(name);
+    const auto preset = find_preset(name);
+    ASSERT_TRUE(preset.has_value());
+    EXPECT_EQ(preset->area, 1.0);
+    EXPECT_GT(preset->mass, 0.05);  // 50 g/m² and up: real fabrics
+    EXPECT_LT(preset->mass, 0.4);
+    for (std::size_t i = 0; i < 3; ++i)
+      EXPECT_LT(preset->phi[i] * preset->phi[i], 4.0 * preset->zeta[i] * preset->xi[i]);
+  }
 }
 
 TEST(Scene, KeysBesidePresetOverrideIt) {
   SceneText text;
-  text.material = "preset = \"denim\"\nxi = [0.1, 0.2, 0.3]\nmass = 3.0\n";
+  text.material = "preset = \"denim-10m\"\nxi = [0.1, 0.2, 0.3]\nmass = 3.0\n";
   const Scene scene = parse(text);
   EXPECT_EQ(scene.material.mass, 3.0);
   EXPECT_EQ(scene.material.xi, (Sym2{0.1, 0.2, 0.3}));
   EXPECT_EQ(scene.material.zeta, (Sym2{100, 100, 100}));
+}
+
+// The keys beside a preset are named in one warning, with where each came from; when they
+// replace all of it, the warning says the preset changes nothing.
+TEST(Scene, PresetOverriddenByKeysWarnsNamingThem) {
+  SceneText text;
+  text.material = "preset = \"denim\"\nxi = [0.1, 0.2, 0.3]\nmass = 3.0\n";
+  const Scene scene = parse(text);
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  const std::string& warning = scene.warnings[0];
+  EXPECT_THAT(warning, StartsWith(std::string(kPath) + ":"));
+  EXPECT_THAT(warning, HasSubstr("preset \"denim\" is overridden by"));
+  EXPECT_THAT(warning, HasSubstr("material.mass (scenes/test.toml:"));
+  EXPECT_THAT(warning, HasSubstr("material.xi (scenes/test.toml:"));
+  EXPECT_THAT(warning, Not(HasSubstr("material.zeta")));
+  EXPECT_THAT(warning, HasSubstr("the preset gives the rest"));
+  EXPECT_EQ(warning.find('\n'), std::string::npos);
+
+  // The complaint: a preset set from the command line on a scene with its own material.
+  const Scene shadowed = parse(SceneText{}, {"material.preset=\"silk\""});
+  ASSERT_EQ(shadowed.warnings.size(), 1u);
+  EXPECT_THAT(shadowed.warnings[0], StartsWith(std::string(kPath) + " (from --set): key 'material.preset'"));
+  for (const char* key : {"material.mass", "material.zeta", "material.xi", "material.phi"})
+    EXPECT_THAT(shadowed.warnings[0], HasSubstr(key));
+  EXPECT_THAT(shadowed.warnings[0], HasSubstr("so the preset changes nothing"));
+
+  // A key from --set is named as such; the preset alone gives no warning.
+  const Scene from_set = parse(text, {"material.phi=0.2"});
+  EXPECT_THAT(from_set.warnings.at(0), HasSubstr("material.phi (scenes/test.toml (from --set))"));
+  EXPECT_TRUE(parse(SceneText{}, {"material={preset=\"silk\"}"}).warnings.empty());
 }
 
 TEST(Scene, DensityConvertsToTotalMass) {
@@ -200,15 +275,18 @@ TEST(Scene, DensityConvertsToTotalMass) {
   EXPECT_DOUBLE_EQ(parse(text).material.mass, 0.25 * 10.0 * 5.0);
 }
 
-TEST(Scene, PresetTableIsThePublishedOne) {
-  ASSERT_EQ(material_presets().size(), 12u);
-  const auto canvas = find_preset("coated-cotton");
+// The published calibrations, kept under their own names with the 10 m sheet they are for.
+TEST(Scene, PublishedCalibrationsKeepTheirNumbers) {
+  ASSERT_EQ(material_presets().size(), 18u);
+  const auto canvas = find_preset("coated-cotton-10m");
   ASSERT_TRUE(canvas.has_value());
-  EXPECT_EQ(canvas->mass_10x10, 125.0);
-  EXPECT_EQ(canvas->zeta, 200.0);
-  EXPECT_EQ(canvas->xi, 0.05);
-  EXPECT_EQ(canvas->phi, 0.01);
+  EXPECT_EQ(canvas->mass, 125.0);
+  EXPECT_EQ(canvas->area, 100.0);
+  EXPECT_EQ(canvas->zeta, (Sym2{200.0, 200.0, 200.0}));
+  EXPECT_EQ(canvas->xi, (Sym2{0.05, 0.05, 0.05}));
+  EXPECT_EQ(canvas->phi, (Sym2{0.01, 0.01, 0.01}));
   EXPECT_FALSE(find_preset("tweed").has_value());
+  EXPECT_FALSE(find_preset("coated-cotton").has_value());
 }
 
 TEST(Scene, IntegratorNamesFollowTheEnum) {
@@ -669,7 +747,7 @@ TEST(SceneError, UnknownPreset) {
   text.material = "preset = \"tweed\"\n";
   EXPECT_THAT(error_of(text),
               AllOf(HasSubstr("key 'material.preset'"), HasSubstr("unknown preset \"tweed\""),
-                    HasSubstr("allowed: silk, cotton, denim")));
+                    HasSubstr("allowed: silk, cotton, linen, wool, polyester, denim, silk-10m")));
 }
 
 TEST(SceneError, UnknownModelAndBorders) {
@@ -827,6 +905,21 @@ TEST(ShippedScenes, LoadWithoutWarnings) {
     EXPECT_EQ(scene.name, path.stem().string());
     EXPECT_TRUE(scene.warnings.empty());
   }
+}
+
+// No shipped scene, in scenes/ or below, names a preset and then replaces part of it: a user
+// running one sees no warning about it.
+TEST(ShippedScenes, NoneOverridesItsPreset) {
+  int scenes = 0;
+  for (const auto& entry :
+       std::filesystem::recursive_directory_iterator(COSSERAT_SOURCE_DIR "/scenes")) {
+    if (entry.path().extension() != ".toml") continue;
+    SCOPED_TRACE(entry.path().string());
+    ++scenes;
+    for (const std::string& warning : load_scene(entry.path().string()).warnings)
+      EXPECT_THAT(warning, Not(HasSubstr("is overridden by")));
+  }
+  EXPECT_GE(scenes, 20);
 }
 
 TEST(ShippedScenes, CompressionLoadsAreTwentyHOneHTwoNewtons) {

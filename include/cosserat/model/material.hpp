@@ -13,18 +13,22 @@ using Sym2 = std::array<double, 3>;
 
 struct Material {
   double mass = 0.0;  // total kg of the sheet
-  Sym2 zeta{};        // metric resistance
-  Sym2 xi{};          // curvature resistance
-  Sym2 phi{};         // buckling factor (metric-curvature coupling)
+  Sym2 zeta{};        // metric resistance, N/m (J/m²)
+  Sym2 xi{};          // curvature resistance, N m (J)
+  Sym2 phi{};         // buckling factor (metric-curvature coupling), N
 };
 
-// A published calibration preset (SCENES.md): mass is for a 10 m x 10 m sheet.
+// A named material (docs/materials.md): the three tensors and the mass of a sheet of `area`
+// square metres, whose areal density a scene keeps at any size. Measured fabrics are given per
+// square metre; the published calibrations per 10 m x 10 m sheet, as published, so that a scene
+// using one gets the mass M·A/100 it always got, to the bit.
 struct Preset {
   std::string name;
-  double mass_10x10;
-  double zeta;
-  double xi;
-  double phi;
+  double mass;  // kg
+  double area;  // m²
+  Sym2 zeta;    // N/m
+  Sym2 xi;      // N m
+  Sym2 phi;     // N
 };
 
 const std::vector<Preset>& material_presets();
