@@ -53,7 +53,7 @@ std::vector<Vec3> smooth_run(Integrator scheme, double dt) {
   scene.integrator = scheme;
   scene.gravity = {0.0, -9.8, 0.0};
   scene.damping = 0.2;
-  scene.fluid = Fluid{0.032, {0.0, 0.0, 5.0}};
+  scene.fluid = Fluid{0.032, {0.0, 0.0, 5.0}, {}};
   scene.fixes.push_back(testing::fix_nodes({{0, 0}}));
   scene.dt = dt;
   Simulation sim(scene, MPI_COMM_SELF, any_scheme);
