@@ -101,7 +101,7 @@ TEST(Gusts, CorrelationFallsOffOverTheCorrelationTimeAndLength) {
     const Vec3 moved = lag.r - lag.tau * kMean;
     const double expected = std::exp(-dot(moved, moved) / (2.0 * kLength * kLength) -
                                      lag.tau * lag.tau / (2.0 * kTime * kTime));
-    EXPECT_NEAR(correlation, expected, 0.04) << "lag " << lag.what;
+    EXPECT_NEAR(correlation, expected, 0.02) << "lag " << lag.what;
   }
 }
 
