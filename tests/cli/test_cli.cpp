@@ -147,7 +147,8 @@ TEST_F(Cli, BadWindIsBadInputAndWritesNothing) {
       cosserat("run " + scene + " --set environment.wind.gust.seed=-1 -o " + path("o.h5"));
   EXPECT_EQ(seed.status, 2) << seed.output;
   EXPECT_THAT(seed.output, HasSubstr("(from --set): key 'environment.wind.gust.seed'"));
-  const Result time = cosserat("run " + write_scene("time.toml", wind("0.0")) + " -o " + path("o.h5"));
+  const Result time =
+      cosserat("run " + write_scene("time.toml", wind("0.0")) + " -o " + path("o.h5"));
   EXPECT_EQ(time.status, 2) << time.output;
   EXPECT_THAT(time.output, HasSubstr("key 'environment.wind.gust.correlation_time'"));
   const std::string fluid = "[environment.fluid]\nviscosity = 1.0\nvelocity = [5.0, 0.0, 0.0]\n";
