@@ -43,7 +43,7 @@ void verlet_step_terms(benchmark::State& state) {
   if (!(terms & 1)) scene.material.xi = {0.0, 0.0, 0.0};
   if (!(terms & 2)) scene.material.phi = {0.0, 0.0, 0.0};
   if (!(terms & 4)) scene.damping = 0.0;
-  if (terms & 8) scene.fluid = cosserat::Fluid{0.05, {1.0, 0.0, 0.5}};
+  if (terms & 8) scene.fluid = cosserat::Fluid{0.05, {1.0, 0.0, 0.5}, {}};
   if (terms & 16) {
     cosserat::Load load;
     for (int l = 0; l < nodes; l += 8)

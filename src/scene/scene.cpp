@@ -265,20 +265,52 @@ void read_model(const Table& model, Scene& scene) {
   }
 }
 
-Fluid read_fluid(const Table& fluid) {
-  fluid.allow({"viscosity", "velocity"});
-  return {non_negative(fluid.require("viscosity", "a number rho_R >= 0")),
-          fluid.require("velocity", "an array of 3 numbers [x, y, z]").vector3()};
+Gusts read_gusts(const Table& gust) {
+  gust.allow({"amplitude", "correlation_time", "correlation_length", "seed"});
+  Gusts gusts;
+  gusts.amplitude = non_negative(
+      gust.require("amplitude", "the rms gust speed in m/s, >= 0 (0: no gusts)"));
+  gusts.correlation_time =
+      positive(gust.require("correlation_time", "the gusts' correlation time in seconds, > 0"));
+  gusts.correlation_length = positive(
+      gust.require("correlation_length", "the gusts' correlation length in metres, > 0"));
+  if (const auto seed = gust.find("seed"))
+    gusts.seed = static_cast<std::uint64_t>(integer_at_least(*seed, 0));
+  return gusts;
+}
+
+// [environment.wind], or the same table under its older name [environment.fluid]; `drag` is
+// likewise the newer name of `viscosity`. Users say wind; MODEL.md §1 says fluid.
+Fluid read_wind(const Table& wind) {
+  wind.allow({"drag", "velocity", "gust", "viscosity"});
+  const auto drag = wind.find("drag");
+  const auto viscosity = wind.find("viscosity");
+  if (drag && viscosity)
+    viscosity->fail(fmt::format("is the older name of {}; give one of the two, not both",
+                                wind.key_of("drag")));
+  if (!drag && !viscosity)
+    wind.missing("drag", "the drag coefficient rho_R >= 0 in N s/m^3 (older name: viscosity)");
+  Fluid fluid;
+  fluid.viscosity = non_negative(drag ? *drag : *viscosity);
+  fluid.velocity =
+      wind.require("velocity", "the mean wind, an array of 3 numbers [x, y, z] in m/s").vector3();
+  if (const auto gust = wind.find_table("gust")) fluid.gusts = read_gusts(*gust);
+  return fluid;
 }
 
 void read_environment(const Table& environment, Scene& scene) {
-  environment.allow({"gravity", "damping", "initial_velocity", "fluid"});
+  environment.allow({"gravity", "damping", "initial_velocity", "wind", "fluid"});
   if (const auto gravity = environment.find("gravity")) scene.gravity = gravity->vector3();
   if (const auto damping = environment.find("damping")) scene.damping = non_negative(*damping);
   if (const auto velocity = environment.find("initial_velocity")) {
     scene.initial_velocity = velocity->vector3();
   }
-  if (const auto fluid = environment.find_table("fluid")) scene.fluid = read_fluid(*fluid);
+  const auto wind = environment.find_table("wind");
+  const auto fluid = environment.find_table("fluid");
+  if (wind && fluid)
+    fluid->fail(fmt::format("is the older name of {}; give one of the two, not both",
+                            environment.key_of("wind")));
+  if (wind || fluid) scene.fluid = read_wind(wind ? *wind : *fluid);
 }
 
 LinearSolver read_solver(const Table& solver) {

@@ -23,6 +23,8 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
       gravity_(scene.gravity),
       damping_(scene.damping),
       fluid_(scene.fluid) {
+  if (fluid_ && fluid_->gusts && fluid_->gusts->amplitude > 0.0)
+    gusts_.emplace(*fluid_->gusts, fluid_->velocity);
   for (const Load& load : scene.loads)
     for (const NodeIndex& node : load.nodes.nodes)
       if (block.owns(node.k, node.l))
@@ -66,7 +68,17 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
   }
   const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
   const Vec3 fluid_velocity = fluid ? fluid_->velocity : Vec3{};
-  if (fluid) {
+  if (gusts_) {
+    // The wind where each node is now (docs/model.md "Wind and gusts").
+    const GustField::Phases phases = gusts_->phases(stage_time_);
+#pragma omp parallel for schedule(static)
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k) {
+        const Vec3 n = (*normals)(k, l);
+        const Vec3 wind = fluid_velocity + gusts_->velocity(r(k, l), phases);
+        a(k, l) += (fluid_coefficient * dot(n, wind)) * n;
+      }
+  } else if (fluid) {
 #pragma omp parallel for schedule(static)
     for (int l = b.l0; l < b.l1; ++l)
 #pragma omp simd

@@ -81,6 +81,7 @@ std::optional<std::string> Midpoint::advance(long step) {
   });
   hold(midpoint_positions_, midpoint_velocity_);
   context_.halo.exchange(midpoint_positions_);
+  dynamics.set_stage_time(context_.time + 0.5 * dt);
   dynamics.acceleration(midpoint_positions_, midpoint_velocity_, step, acceleration_, normals());
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) = positions_(k, l) + dt * midpoint_velocity_(k, l);
@@ -110,6 +111,8 @@ std::optional<std::string> RungeKutta4::advance(long step) {
     stage_velocity_(k, l) = velocity_(k, l) + (0.5 * dt) * acceleration_(k, l);
   });
   hold(stage_positions_, stage_velocity_);
+  // Stages 2 and 3 belong to the step's middle, stage 4 to its end.
+  dynamics.set_stage_time(context_.time + 0.5 * dt);
   for (const double fraction : {0.5, 1.0}) {
     halo.exchange(stage_positions_);
     dynamics.acceleration(stage_positions_, stage_velocity_, step, acceleration_, normals());
@@ -123,6 +126,7 @@ std::optional<std::string> RungeKutta4::advance(long step) {
     hold(stage_positions_, stage_velocity_);
   }
   halo.exchange(stage_positions_);
+  dynamics.set_stage_time(context_.time + dt);
   dynamics.acceleration(stage_positions_, stage_velocity_, step, acceleration_, normals());
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) =

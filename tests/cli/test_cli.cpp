@@ -133,6 +133,35 @@ TEST_F(Cli, BadOverrideIsBadInput) {
   EXPECT_EQ(cosserat("run " + scene + " --set nokey -o " + path("o.h5")).status, 2);
 }
 
+// The wind's keys are checked like every other: a bad gust key, from the file or from --set,
+// and the wind given under both its names are bad input naming the keys, before any output.
+TEST_F(Cli, BadWindIsBadInputAndWritesNothing) {
+  const auto wind = [](const std::string& correlation_time) {
+    return std::string(kSmallScene) +
+           "[environment.wind]\ndrag = 1.0\nvelocity = [5.0, 0.0, 0.0]\n"
+           "gust = { amplitude = 1.0, correlation_time = " + correlation_time +
+           ", correlation_length = 2.0, seed = 3 }\n";
+  };
+  const std::string scene = write_scene("wind.toml", wind("1.0"));
+  const Result seed =
+      cosserat("run " + scene + " --set environment.wind.gust.seed=-1 -o " + path("o.h5"));
+  EXPECT_EQ(seed.status, 2) << seed.output;
+  EXPECT_THAT(seed.output, HasSubstr("(from --set): key 'environment.wind.gust.seed'"));
+  const Result time =
+      cosserat("run " + write_scene("time.toml", wind("0.0")) + " -o " + path("o.h5"));
+  EXPECT_EQ(time.status, 2) << time.output;
+  EXPECT_THAT(time.output, HasSubstr("key 'environment.wind.gust.correlation_time'"));
+  const std::string fluid = "[environment.fluid]\nviscosity = 1.0\nvelocity = [5.0, 0.0, 0.0]\n";
+  const Result both =
+      cosserat("run " + write_scene("both.toml", wind("1.0") + fluid) + " -o " + path("o.h5"));
+  EXPECT_EQ(both.status, 2) << both.output;
+  EXPECT_THAT(both.output, HasSubstr("key 'environment.fluid'"));
+  EXPECT_THAT(both.output, HasSubstr("environment.wind"));
+  EXPECT_FALSE(fs::exists(path("o.h5")));
+  const Result gusty = cosserat("run " + scene + " -q --set time.steps=20 -o " + path("g.h5"));
+  EXPECT_EQ(gusty.status, 0) << gusty.output;
+}
+
 TEST_F(Cli, BadSolidIsBadInputAndWritesNothing) {
   const std::string scene = write_scene(
       "solid.toml", std::string(kSmallScene) +

@@ -73,11 +73,11 @@ class Restart : public SharedFolder {
     ASSERT_TRUE(testing::advance(sim, scene.steps - scene.steps / 2));
     EXPECT_EQ(sim.step_index(), scene.steps);
   }
-};
 
-TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
-  for (const Integrator integrator : explicit_integrators()) {
-    const Scene scene = testing::odd_grid_scene(integrator);  // 80 steps
+  // Checkpoints `scene` at half its steps on all ranks, continues on another split and, on
+  // every rank alone, on one block: both end bitwise where one uninterrupted block ends.
+  void expect_restarts_bitwise(const Scene& scene) const {
+    const std::string scheme = integrator_name(scene.integrator);
     const auto splits = all_splits(scene.m, scene.n, world_size());
     Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);  // one block: the comparisons' reference
     ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
@@ -86,19 +86,31 @@ TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
     Simulation other_split(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
     continue_to_end(other_split, scene);
     EXPECT_EQ(differing_nodes(other_split.positions(), uninterrupted.positions()), 0)
-        << integrator_name(integrator) << ", split " << testing::split_name(splits.back());
+        << scheme << ", split " << testing::split_name(splits.back());
     EXPECT_EQ(differing_nodes(other_split.velocities(), uninterrupted.velocities()), 0)
-        << integrator_name(integrator);
+        << scheme;
 
     // Every rank restarts the whole grid alone from the file the P ranks wrote.
     Simulation one_rank(scene, MPI_COMM_SELF, any_scheme);
     continue_to_end(one_rank, scene);
     EXPECT_EQ(differing_nodes(one_rank.positions(), uninterrupted.positions()), 0)
-        << integrator_name(integrator) << " restarted on one rank";
+        << scheme << " restarted on one rank";
     EXPECT_EQ(differing_nodes(one_rank.velocities(), uninterrupted.velocities()), 0)
-        << integrator_name(integrator) << " restarted on one rank";
-    MPI_Barrier(MPI_COMM_WORLD);  // every rank has read it before the next scheme's replaces it
+        << scheme << " restarted on one rank";
+    MPI_Barrier(MPI_COMM_WORLD);  // every rank has read it before the next run replaces it
   }
+};
+
+TEST_F(Restart, ContinuesBitwiseOnAnotherSplitAndOnOneRank) {
+  for (const Integrator integrator : explicit_integrators())
+    expect_restarts_bitwise(testing::odd_grid_scene(integrator));  // 80 steps
+}
+
+// The gusts are a function of position, time and seed: the checkpoint holds nothing for them,
+// and a restart reads them at the same times, bitwise.
+TEST_F(Restart, InGustsContinuesBitwiseOnAnotherSplitAndOnOneRank) {
+  for (const Integrator integrator : explicit_integrators())
+    expect_restarts_bitwise(testing::gusty_odd_grid_scene(integrator));
 }
 
 #if defined(COSSERAT_HAVE_PETSC)
@@ -339,37 +351,49 @@ class FirstCheckpoint : public StepObserver {
   bool written_ = false;
 };
 
+// Runs `scene` (adaptive steps) uninterrupted on one block, and on all ranks checkpointed at
+// step 150 (checkpoints every 150 steps, the first kept) and restarted on another split: both
+// end bitwise alike.
+void expect_adaptive_restart_bitwise(const Scene& scene, const std::string& checkpoint) {
+  const std::string scheme = integrator_name(scene.integrator);
+  Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
+  StepLoopOptions options;
+  options.checkpoint_every = 150;
+  // The same schedule: a checkpoint is also where roll-backs stop.
+  FirstCheckpoint none(uninterrupted, scene, "");
+  const StepLoopResult expected = run_step_loop(uninterrupted, scene, options, none);
+  ASSERT_FALSE(expected.failure) << scheme;
+  EXPECT_GE(expected.adaptive->rollbacks, 1) << scheme;
+
+  Simulation first(scene, MPI_COMM_WORLD, any_scheme);
+  FirstCheckpoint keep(first, scene, checkpoint);
+  ASSERT_FALSE(run_step_loop(first, scene, options, keep).failure);
+
+  const auto splits = all_splits(scene.m, scene.n, world_size());
+  Simulation restarted(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
+  double scale = 0.0;
+  EXPECT_EQ(read_checkpoint(checkpoint, restarted, scene, nullptr, &scale), 150);
+  options.adaptive_scale = scale;
+  FirstCheckpoint ignore(restarted, scene, "");
+  ASSERT_FALSE(run_step_loop(restarted, scene, options, ignore).failure);
+  EXPECT_EQ(restarted.time(), uninterrupted.time());
+  EXPECT_EQ(restarted.step_index(), uninterrupted.step_index()) << scheme;
+  EXPECT_EQ(differing_nodes(restarted.positions(), uninterrupted.positions()), 0) << scheme;
+  MPI_Barrier(MPI_COMM_WORLD);  // every rank has read it before the next run replaces it
+}
+
 // Adaptive steps restart bitwise: the checkpoint holds the last step (tc-verlet's previous step)
 // and what roll-backs left of the estimate, and the restarted run holds the same states to roll
-// back to. Checkpoints every 150 steps, the first kept; restarted on another split.
+// back to.
 TEST_F(Restart, AdaptiveStepsContinueBitwise) {
-  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
-    const Scene scene = testing::rolling_back_scene(integrator);
-    Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
-    StepLoopOptions options;
-    options.checkpoint_every = 150;
-    // The same schedule: a checkpoint is also where roll-backs stop.
-    FirstCheckpoint none(uninterrupted, scene, "");
-    const StepLoopResult expected = run_step_loop(uninterrupted, scene, options, none);
-    ASSERT_FALSE(expected.failure);
-    EXPECT_GE(expected.adaptive->rollbacks, 1);
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet})
+    expect_adaptive_restart_bitwise(testing::rolling_back_scene(integrator), checkpoint());
+}
 
-    Simulation first(scene, MPI_COMM_WORLD, any_scheme);
-    FirstCheckpoint keep(first, scene, checkpoint());
-    ASSERT_FALSE(run_step_loop(first, scene, options, keep).failure);
-
-    const auto splits = all_splits(scene.m, scene.n, world_size());
-    Simulation restarted(scene, MPI_COMM_WORLD, splits.back(), any_scheme);
-    double scale = 0.0;
-    EXPECT_EQ(read_checkpoint(checkpoint(), restarted, scene, nullptr, &scale), 150);
-    options.adaptive_scale = scale;
-    FirstCheckpoint ignore(restarted, scene, "");
-    ASSERT_FALSE(run_step_loop(restarted, scene, options, ignore).failure);
-    EXPECT_EQ(restarted.time(), uninterrupted.time());
-    EXPECT_EQ(restarted.step_index(), uninterrupted.step_index()) << integrator_name(integrator);
-    EXPECT_EQ(differing_nodes(restarted.positions(), uninterrupted.positions()), 0)
-        << integrator_name(integrator);
-  }
+// In gusts, which rk4 reads at the middle and the end of steps whose sizes vary.
+TEST_F(Restart, AdaptiveStepsInGustsContinueBitwise) {
+  expect_adaptive_restart_bitwise(testing::gusty_rolling_back_scene(Integrator::rk4),
+                                  checkpoint());
 }
 
 // With a free body in contact, the checkpoint also holds the solids' state: a restart on

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <string>
 
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/halo.hpp"
@@ -108,42 +109,46 @@ TEST(DecompositionInvariance, WithoutTheHaloTheBorderForcesDiffer) {
   EXPECT_GT(differing_nodes(f, reference.force), 0);
 }
 
-// The whole trajectory, every integrator, every split: positions and velocities after 80 steps
-// (through a load window ending and a fix switching on) equal the one-block run's.
-TEST(DecompositionInvariance, EveryIntegratorFollowsTheOneBlockTrajectory) {
-  for (const Integrator integrator : explicit_integrators()) {
-    const Scene scene = testing::odd_grid_scene(integrator);
-    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
-    ASSERT_TRUE(testing::advance(reference, scene.steps));
-    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
-      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
-      const bool stable = testing::advance(sim, scene.steps);
-      ASSERT_TRUE(stable);
-      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
-          << integrator_name(integrator) << ", split " << split_name(d);
-      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
-          << integrator_name(integrator) << ", split " << split_name(d);
-    }
+// Runs `scene` for its steps on every split of the world's ranks: positions and velocities
+// equal the one-block run's, bitwise.
+void expect_every_split_follows_one_block(const Scene& scene) {
+  const std::string scheme = integrator_name(scene.integrator);
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(reference, scene.steps)) << scheme;
+  for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+    Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+    const bool stable = testing::advance(sim, scene.steps);
+    ASSERT_TRUE(stable) << scheme << ", split " << split_name(d);
+    EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+        << scheme << ", split " << split_name(d);
+    EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+        << scheme << ", split " << split_name(d);
   }
 }
 
-// The test above runs the default, the energy form, which gathers each node's force from its
+// The whole trajectory, every integrator, every split: positions and velocities after 80 steps
+// (through a load window ending and a fix switching on) equal the one-block run's.
+TEST(DecompositionInvariance, EveryIntegratorFollowsTheOneBlockTrajectory) {
+  for (const Integrator integrator : explicit_integrators())
+    expect_every_split_follows_one_block(testing::odd_grid_scene(integrator));
+}
+
+// Gusts are a function of position, time and seed alone (docs/model.md "Wind and gusts"): in
+// them too every integrator, each reading the wind at its stages' times, follows the one-block
+// trajectory bitwise.
+TEST(DecompositionInvariance, EveryIntegratorInGustsFollowsTheOneBlockTrajectory) {
+  for (const Integrator integrator : explicit_integrators())
+    expect_every_split_follows_one_block(testing::gusty_odd_grid_scene(integrator));
+}
+
+// The tests above run the default, the energy form, which gathers each node's force from its
 // neighbours' gradients in a fixed order; the flux form too gives the same trajectory bitwise
 // on every split, for a scheme of each state kind.
 TEST(DecompositionInvariance, FluxFormFollowsTheOneBlockTrajectory) {
   for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
     Scene scene = testing::odd_grid_scene(integrator);
     scene.discretisation = Discretisation::flux;
-    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
-    ASSERT_TRUE(testing::advance(reference, scene.steps));
-    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
-      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
-      ASSERT_TRUE(testing::advance(sim, scene.steps));
-      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
-          << integrator_name(integrator) << ", split " << split_name(d);
-      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
-          << integrator_name(integrator) << ", split " << split_name(d);
-    }
+    expect_every_split_follows_one_block(scene);
   }
 }
 
@@ -169,6 +174,29 @@ TEST(DecompositionInvariance, S2CapeFollowsTheOneBlockTrajectory) {
     }
 }
 
+// The gallery's gusting flag as shipped, its first 0.1 s (1000 steps), with one and three
+// threads per rank against the reference's count.
+TEST(DecompositionInvariance, GustingFlagFollowsTheOneBlockTrajectory) {
+  const Scene scene = load_scene(COSSERAT_SOURCE_DIR "/scenes/gallery/flag_gusts.toml",
+                                 {"time.duration=0.1"});
+  ASSERT_TRUE(scene.fluid && scene.fluid->gusts && scene.fluid->gusts->amplitude > 0.0);
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(reference, scene.steps));
+  const int default_threads = omp_get_max_threads();
+  for (const int threads : {1, 3})
+    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+      omp_set_num_threads(threads);
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+      const bool stable = testing::advance(sim, scene.steps);
+      omp_set_num_threads(default_threads);
+      ASSERT_TRUE(stable);
+      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+          << "split " << split_name(d) << ", " << threads << " threads";
+      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+          << "split " << split_name(d) << ", " << threads << " threads";
+    }
+}
+
 // An observer of nothing: the adaptive step loop's choices alone are compared.
 class Silent : public StepObserver {
  public:
@@ -178,25 +206,29 @@ class Silent : public StepObserver {
 };
 
 // Adaptive steps choose each step from global maxima: the same steps, the same roll-back and the
-// same trajectory, bitwise, on every split, for a scheme of each state kind.
+// same trajectory, bitwise, on every split, for a scheme of each state kind; in gusts too, read
+// at the times of steps of every size.
 TEST(DecompositionInvariance, AdaptiveStepsAndTheirRollBacksFollowTheOneBlockRun) {
   for (const Integrator integrator : {Integrator::verlet, Integrator::rk4}) {
-    const Scene scene = testing::rolling_back_scene(integrator);
-    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
-    Silent silent;
-    const StepLoopResult expected = run_step_loop(reference, scene, {}, silent);
-    ASSERT_FALSE(expected.failure);
-    ASSERT_TRUE(expected.adaptive);
-    EXPECT_GE(expected.adaptive->rollbacks, 1) << integrator_name(integrator);
-    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
-      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
-      const StepLoopResult result = run_step_loop(sim, scene, {}, silent);
-      ASSERT_FALSE(result.failure);
-      EXPECT_EQ(sim.step_index(), reference.step_index()) << split_name(d);
-      EXPECT_EQ(result.adaptive->rollbacks, expected.adaptive->rollbacks) << split_name(d);
-      EXPECT_EQ(result.adaptive->smallest_dt, expected.adaptive->smallest_dt) << split_name(d);
-      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
-          << integrator_name(integrator) << ", split " << split_name(d);
+    for (const Scene& scene : {testing::rolling_back_scene(integrator),
+                               testing::gusty_rolling_back_scene(integrator)}) {
+      const std::string what = integrator_name(integrator) + (scene.fluid ? " in gusts" : "");
+      Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+      Silent silent;
+      const StepLoopResult expected = run_step_loop(reference, scene, {}, silent);
+      ASSERT_FALSE(expected.failure) << what;
+      ASSERT_TRUE(expected.adaptive);
+      EXPECT_GE(expected.adaptive->rollbacks, 1) << what;
+      for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+        Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+        const StepLoopResult result = run_step_loop(sim, scene, {}, silent);
+        ASSERT_FALSE(result.failure);
+        EXPECT_EQ(sim.step_index(), reference.step_index()) << what << ", " << split_name(d);
+        EXPECT_EQ(result.adaptive->rollbacks, expected.adaptive->rollbacks) << split_name(d);
+        EXPECT_EQ(result.adaptive->smallest_dt, expected.adaptive->smallest_dt) << split_name(d);
+        EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+            << what << ", split " << split_name(d);
+      }
     }
   }
 }

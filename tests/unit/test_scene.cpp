@@ -101,6 +101,50 @@ TEST(Scene, MinimalSceneHasTheDocumentedDefaults) {
   EXPECT_EQ(scene.text, SceneText{}.str());
 }
 
+// [environment.wind]: the fluid term under the name users give it, with gusts.
+TEST(Scene, WindIsReadWithItsGusts) {
+  SceneText text;
+  text.tail = R"(
+[environment.wind]
+drag = 3.5
+velocity = [5.0, 0.0, 0.5]
+gust = { amplitude = 1.5, correlation_time = 2.0, correlation_length = 4.0, seed = 42 }
+)";
+  const Scene scene = parse(text);
+  ASSERT_TRUE(scene.fluid.has_value());
+  EXPECT_EQ(scene.fluid->viscosity, 3.5);
+  EXPECT_EQ(scene.fluid->velocity.x, 5.0);
+  EXPECT_EQ(scene.fluid->velocity.z, 0.5);
+  ASSERT_TRUE(scene.fluid->gusts.has_value());
+  EXPECT_EQ(scene.fluid->gusts->amplitude, 1.5);
+  EXPECT_EQ(scene.fluid->gusts->correlation_time, 2.0);
+  EXPECT_EQ(scene.fluid->gusts->correlation_length, 4.0);
+  EXPECT_EQ(scene.fluid->gusts->seed, 42u);
+}
+
+// [environment.fluid] and `viscosity` are the older names of [environment.wind] and `drag`:
+// any mix of the names reads the same wind. A wind without a gust table has none; a gust
+// table without a seed has seed 0.
+TEST(Scene, FluidAndViscosityAreTheOlderNames) {
+  for (const char* table : {"wind", "fluid"})
+    for (const char* coefficient : {"drag", "viscosity"}) {
+      SceneText text;
+      text.tail = std::string("[environment.") + table + "]\n" + coefficient +
+                  " = 0.25\nvelocity = [1, 2, 3]\n";
+      const Scene calm = parse(text);
+      ASSERT_TRUE(calm.fluid.has_value()) << table << " " << coefficient;
+      EXPECT_EQ(calm.fluid->viscosity, 0.25);
+      EXPECT_EQ(calm.fluid->velocity.y, 2.0);
+      EXPECT_FALSE(calm.fluid->gusts.has_value());
+      text.tail += std::string("[environment.") + table +
+                   ".gust]\namplitude = 1\ncorrelation_time = 2\ncorrelation_length = 3\n";
+      const Scene gusty = parse(text);
+      ASSERT_TRUE(gusty.fluid->gusts.has_value());
+      EXPECT_EQ(gusty.fluid->gusts->correlation_length, 3.0);
+      EXPECT_EQ(gusty.fluid->gusts->seed, 0u);
+    }
+}
+
 TEST(Scene, OutputEveryIsAtLeastOne) {
   SceneText text;
   text.time = "dt = 0.001\nsteps = 50\n";
@@ -410,6 +454,18 @@ TEST(SceneSet, CreatesMissingTables) {
   EXPECT_EQ(scene.borders, Borders::published);
 }
 
+TEST(SceneSet, GustKeys) {
+  SceneText text;
+  text.tail = "[environment.wind]\ndrag = 1\nvelocity = [5, 0, 0]\n";
+  const Scene scene = parse(text, {"environment.wind.gust.amplitude=0.5",
+                                   "environment.wind.gust.correlation_time=1",
+                                   "environment.wind.gust.correlation_length=2",
+                                   "environment.wind.gust.seed=5"});
+  ASSERT_TRUE(scene.fluid && scene.fluid->gusts);
+  EXPECT_EQ(scene.fluid->gusts->amplitude, 0.5);
+  EXPECT_EQ(scene.fluid->gusts->seed, 5u);
+}
+
 TEST(SceneSet, WithoutEqualsIsRejected) {
   EXPECT_THAT(error_of(SceneText{}, {"time.dt"}),
               AllOf(HasSubstr("--set 'time.dt'"), HasSubstr("dotted.key=value")));
@@ -468,7 +524,7 @@ TEST(SceneError, UnknownKeyInANestedTable) {
   SceneText text;
   text.tail = "[environment.fluid]\nviscosity = 1\nvelocity = [1, 0, 0]\ndensity = 1.2\n";
   EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.fluid.density'"),
-                                    HasSubstr("allowed here: viscosity, velocity")));
+                                    HasSubstr("allowed here: drag, velocity, gust, viscosity")));
 }
 
 TEST(SceneError, UnknownKeyInAFixBlock) {
@@ -825,6 +881,65 @@ TEST(SceneError, FluidWithoutVelocity) {
   text.tail = "[environment.fluid]\nviscosity = 1\n";
   EXPECT_THAT(error_of(text),
               AllOf(HasSubstr("key 'environment.fluid.velocity'"), HasSubstr("required")));
+}
+
+TEST(SceneError, WindAndFluidTogether) {
+  SceneText text;
+  text.tail = "[environment.wind]\ndrag = 1\nvelocity = [1, 0, 0]\n"
+              "[environment.fluid]\nviscosity = 1\nvelocity = [1, 0, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.fluid'"),
+                                    HasSubstr("older name of environment.wind"),
+                                    HasSubstr("not both")));
+}
+
+TEST(SceneError, DragAndViscosityTogether) {
+  SceneText text;
+  text.tail = "[environment.wind]\ndrag = 1\nviscosity = 1\nvelocity = [1, 0, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.wind.viscosity'"),
+                                    HasSubstr("older name of environment.wind.drag")));
+}
+
+TEST(SceneError, WindWithoutDrag) {
+  SceneText text;
+  text.tail = "[environment.wind]\nvelocity = [1, 0, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.wind.drag'"),
+                                    HasSubstr("required"), HasSubstr("N s/m^3")));
+}
+
+// Every gust key is checked, and the message names its full key.
+TEST(SceneError, BadGusts) {
+  const std::string wind = "[environment.wind]\ndrag = 1\nvelocity = [5, 0, 0]\n";
+  const std::string valid = "amplitude = 1, correlation_time = 2, correlation_length = 3";
+  struct Case {
+    std::string gust, key, what;
+  };
+  const Case cases[] = {
+      {"amplitude = -1, correlation_time = 2, correlation_length = 3", "amplitude",
+       "must be >= 0, got -1"},
+      {"amplitude = 1, correlation_time = 0, correlation_length = 3", "correlation_time",
+       "must be > 0, got 0"},
+      {"amplitude = 1, correlation_time = 2, correlation_length = -3", "correlation_length",
+       "must be > 0, got -3"},
+      {"amplitude = 1, correlation_time = 2", "correlation_length", "required"},
+      {"correlation_time = 2, correlation_length = 3", "amplitude", "required"},
+      {valid + ", seed = -3", "seed", "must be >= 0, got -3"},
+      {valid + ", seed = 1.5", "seed", "must be an integer"},
+      {valid + ", seed = \"x\"", "seed", "must be an integer"},
+      {valid + ", period = 2", "period",
+       "allowed here: amplitude, correlation_time, correlation_length, seed"},
+      {"amplitude = inf, correlation_time = 2, correlation_length = 3", "amplitude", ""},
+  };
+  for (const Case& c : cases) {
+    SceneText text;
+    text.tail = wind + "gust = { " + c.gust + " }\n";
+    EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'environment.wind.gust." + c.key + "'"),
+                                      HasSubstr(c.what)))
+        << c.gust;
+  }
+  SceneText text;
+  text.tail = wind + "gust = 3\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'environment.wind.gust'"), HasSubstr("must be a table")));
 }
 
 TEST(SceneError, RegionWithTwoShapes) {

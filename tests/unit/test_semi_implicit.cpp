@@ -22,7 +22,7 @@ Scene busy_sheet(Integrator scheme) {
   scene.integrator = scheme;
   scene.gravity = {0.0, -9.8, 0.0};
   scene.damping = 0.2;
-  scene.fluid = Fluid{0.032, {3.0, 1.0, 5.0}};
+  scene.fluid = Fluid{0.032, {3.0, 1.0, 5.0}, {}};
   scene.initial_velocity = {0.2, 0.5, -0.1};
   scene.fixes.push_back(testing::fix_nodes({{0, 0}}));
   Fix later = testing::fix_nodes({{8, 6}, {4, 3}});

@@ -16,7 +16,7 @@ std::vector<Vec3> run_with_threads(int threads, Integrator scheme) {
   scene.integrator = scheme;
   scene.gravity = {0.0, -9.8, 0.0};
   scene.damping = 0.2;
-  scene.fluid = Fluid{0.032, {3.0, 0.0, 1.0}};
+  scene.fluid = Fluid{0.032, {3.0, 0.0, 1.0}, {}};
   scene.fixes.push_back(testing::fix_nodes({{0, 0}, {0, 10}}));
   Load load;
   load.nodes.nodes = {{12, 5}};

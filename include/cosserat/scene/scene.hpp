@@ -3,6 +3,7 @@
 // (shared/spec/SCENE_FORMAT.md). Data flows one way: file -> Scene -> Simulation.
 
 #include <array>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -69,9 +70,21 @@ struct AdaptiveStep {
   double safety = 0.5;  // the fraction of the estimate taken
 };
 
+// Gusts on top of the mean wind: a sum of random Fourier modes drawn from the seed
+// (docs/model.md "Wind and gusts").
+struct Gusts {
+  double amplitude = 0.0;           // m/s: the rms of the gust velocity, all components
+  double correlation_time = 0.0;    // s: T
+  double correlation_length = 0.0;  // m: L
+  std::uint64_t seed = 0;
+};
+
+// The fluid term of MODEL.md §1, which scenes call wind: [environment.wind], or its older name
+// [environment.fluid].
 struct Fluid {
-  double viscosity = 0.0;  // rho_R
-  Vec3 velocity;           // u
+  double viscosity = 0.0;  // rho_R, N s/m^3 (the scene's `drag`)
+  Vec3 velocity;           // u: the mean wind, m/s
+  std::optional<Gusts> gusts;  // none, or amplitude 0: u is constant
 };
 
 // [time.solver]: the linear solver of the semi-implicit integrator, in PETSc's names. PETSc's

@@ -9,6 +9,7 @@
 #include "cosserat/model/cosserat_energy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "cosserat/scene/scene.hpp"
+#include "cosserat/time/gust_field.hpp"
 
 namespace cosserat {
 
@@ -39,8 +40,15 @@ class Dynamics {
                     Field<Vec3>* normals);
 
   // The time at which the step the next evaluations belong to starts: load windows in seconds
-  // are told by it, as those in steps are by `step`.
-  void set_time(double time) { time_ = time; }
+  // are told by it, as those in steps are by `step`. The wind's gusts are evaluated at it too,
+  // until set_stage_time says otherwise.
+  void set_time(double time) {
+    time_ = time;
+    stage_time_ = time;
+  }
+  // The time of a stage inside the step (midpoint, rk4), where the next evaluations take the
+  // gusts; load windows still go by the step.
+  void set_stage_time(double time) { stage_time_ = time; }
 
   bool has_fluid() const { return fluid_.has_value(); }
   // The stored energy E of MODEL.md §2.5 (J), a global sum; reads the ghosts of r. For the
@@ -75,9 +83,11 @@ class Dynamics {
   Vec3 gravity_;
   double damping_;
   std::optional<Fluid> fluid_;
+  std::optional<GustField> gusts_;  // with a gust amplitude > 0 only
   std::vector<PointLoad> loads_;
   bool needs_area_;
   double time_ = 0.0;
+  double stage_time_ = 0.0;
 };
 
 }  // namespace cosserat
