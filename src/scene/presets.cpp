@@ -1,5 +1,6 @@
-// Material presets (docs/materials.md): fabrics at their real size from published measurements,
-// and the published 10 m calibrations under names of their own.
+// Material presets (docs/materials.md): fabrics at their real size from KES-F numbers (one
+// published measurement, five typical values), and the published 10 m calibrations under names
+// of their own.
 
 #include <algorithm>
 #include <cmath>
@@ -59,7 +60,9 @@ double coupling_fraction(double zeta, double xi, double phi) {
 }  // namespace
 
 const std::vector<Preset>& material_presets() {
-  // Sources and the reasons for each number: docs/materials.md. Wool and polyester have no
+  // Sources and the reasons for each number: docs/materials.md. Only denim's KES-F numbers were
+  // read from a published table; silk, cotton, linen, wool and polyester are typical values,
+  // unverified, kept until a measured specimen of each replaces them. Wool and polyester have no
   // calibration; their coupling is 0.03, inside the calibrations' 0.0025 (linen) to 0.05 (silk).
   static const std::vector<Preset> presets{
       measured_fabric({"silk", 60.0, 0.03, 0.4, 8.0, coupling_fraction(100.0, 0.01, 0.1)}),
