@@ -42,19 +42,25 @@ mem="$(memory "$BEFORE" 1024) $(memory "$BEFORE" 2048) $(memory "$after" 1024) $
   "$mem" "${runs[@]}" <<'PY'
 import json, statistics, sys
 stem, cpu, compiler, revision, date, before_revision, terms_file, mem = sys.argv[1:9]
-rates = {}
+rates, cpu_rates = {}, {}
 for run in sys.argv[9:]:
     which, path = run.split(":", 1)
     for b in json.load(open(path))["benchmarks"]:
         fields = dict(p.split(":") for p in b["name"].split("/")[1:] if ":" in p)
         key = (which, int(fields["nodes"]), int(fields["threads"]))
         rates.setdefault(key, []).append(b["items_per_second"])
+        # The main thread's CPU time: on one thread, the step's own time even when other work
+        # shares the cores.
+        cpu_rates.setdefault(key, []).append(int(fields["nodes"]) ** 2 / (b["cpu_time"] * 1e-3))
 lines = [f"# The Verlet step before and after the kernel work, {date}", "",
          f"Machine: {cpu}; compiler: {compiler}, -O3 -march=native; 1 rank.",
          f"Before: git {before_revision}; after: git {revision}. `benchmarks/run_kernel.sh`: the two",
          "binaries alternately, each case twice (at least 2 s each); both runs listed.", "",
+         "Rates by wall time; on one thread also by CPU time, which other work on the machine",
+         "does not inflate.", "",
          "| grid | threads | before (node-steps/s) | after (node-steps/s) | speed-up | "
-         "after, 2 threads over 1 |", "|---|---|---|---|---|---|"]
+         "after, 2 threads over 1 | 1 thread by CPU time, before → after |",
+         "|---|---|---|---|---|---|---|"]
 for nodes in sorted({k[1] for k in rates}):
     for threads in (1, 2):
         b, a = rates.get(("before", nodes, threads)), rates.get(("after", nodes, threads))
@@ -64,7 +70,10 @@ for nodes in sorted({k[1] for k in rates}):
         lines.append(f"| {nodes}² | {threads} | {', '.join(f'{r:.3g}' for r in b)} | "
                      f"{', '.join(f'{r:.3g}' for r in a)} | "
                      f"{statistics.median(a) / statistics.median(b):.2f} | "
-                     f"{statistics.median(a) / one:.2f} |")
+                     f"{statistics.median(a) / one:.2f} | " +
+                     (f"{statistics.median(cpu_rates[('before', nodes, 1)]):.3g} → "
+                      f"{statistics.median(cpu_rates[('after', nodes, 1)]):.3g} |" if threads == 1
+                      else " |"))
 b1, b2, a1, a2 = (float(x) * 1024 for x in mem.split())
 per_node = lambda small, large: (large - small) / (2048 ** 2 - 1024 ** 2)
 lines += ["", "Peak resident memory per node (difference of the 2048² and 1024² runs, "
