@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Node-steps per second of one Verlet step (bench_step) on 256², 1024², 2048² with 1 and 2
+# Node-steps per second of one Verlet step (bench_step) on 256², 1024², 2048², 4096² with 1 and 2
 # threads, into benchmarks/results/throughput-<host>-<date>.{json,md} with the machine,
 # compiler, git revision, ranks x threads and date beside every number.
 #   benchmarks/run_throughput.sh [extra Google Benchmark flags]
@@ -7,7 +7,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 source benchmarks/context.sh throughput benchmark bench_step
 
-run_step_benchmark build/benchmark/benchmarks/bench_step "$@"
+run_step_benchmark build/benchmark/benchmarks/bench_step --benchmark_filter='verlet_step/' "$@"
 
 /usr/bin/python3 - "$stem" "$cpu" "$compiler" "$revision" "$date" <<'PY'
 import json, sys
