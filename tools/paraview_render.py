@@ -4,7 +4,7 @@
     pvpython tools/paraview_render.py RUN.xmf [--field F] [--frame N | --time T]
                                       [-o OUT.png] [--size W H] [--elev E] [--azim A]
 
-Opens the run's XDMF file with ParaView's Xdmf3 reader, the one the GUI uses, shows the frame
+Opens the run's XDMF file with ParaView's Xdmf3 reader, as the GUI does, shows the frame
 (default: the last) coloured by F (curvature by default; velocity is drawn as its length), and
 saves a screenshot, by default RUN_F.png beside the run. Without a display, run it under
 xvfb-run (Debian's xvfb): `xvfb-run -a pvpython tools/paraview_render.py ...`. Exit status 2,
@@ -90,7 +90,7 @@ def frame_time(times, frame, time):
 def cloth_arrays(reader, time, field):
     """The cloth's node positions [N, 3] and the field's values [N] (the velocity's length) at
     `time`. A run with solids is a collection of the cloth's grid and one surface per solid;
-    the cloth is the block that holds the structured grid."""
+    the cloth is the block that is a structured grid."""
     data = servermanager.Fetch(reader)
     blocks = [data]
     if data.IsA("vtkMultiBlockDataSet") or data.IsA("vtkDataObjectTree"):
@@ -140,7 +140,9 @@ def place_camera(view, points, elev, azim):
     view.CameraFocalPoint = centre.tolist()
     view.CameraPosition = (centre + towards).tolist()
     view.CameraViewUp = [0.0, 1.0, 0.0]
-    view.ResetCamera(False)
+    # Fitted to the cloth: a floor is drawn twice the sheet's size.
+    low, high = points.min(axis=0), points.max(axis=0)
+    view.ResetCamera([low[0], high[0], low[1], high[1], low[2], high[2]], False)
 
 
 def colour_range(values, centre):
@@ -161,8 +163,10 @@ def render(arguments):
     if not os.path.isfile(xmf):
         raise InputError(f"{arguments.xmf}: no such file")
     # The Xdmf3 readers join a relative file name's empty folder to the HDF5 file's name
-    # ("run.xmfrun.h5"): they are given an absolute path.
-    reader = simple.Xdmf3ReaderS(FileName=[xmf])
+    # ("run.xmfrun.h5"): they are given an absolute path. Reader T, because with solids Reader
+    # S makes the cloth and the solids pieces of one dataset, which ParaView 5.11 then colours
+    # by no field at all; T keeps them separate blocks.
+    reader = simple.Xdmf3ReaderT(FileName=[xmf])
     reader.UpdatePipelineInformation()
     # One frame's time comes as a number, several as a list, none as an empty list.
     steps = reader.TimestepValues
@@ -186,7 +190,7 @@ def render(arguments):
     display = simple.Show(reader, view)
     display.Representation = "Surface"
     if arguments.field == "none":
-        simple.ColorBy(display, None)
+        display.ColorArrayName = ["POINTS", ""]
         display.AmbientColor = display.DiffuseColor = CLOTH_COLOUR
     else:
         label, colour_map, centre = FIELDS[arguments.field]
