@@ -6,8 +6,10 @@
 
 Opens the run's XDMF file with ParaView's Xdmf3 reader, as the GUI does, shows the frame
 (default: the last) coloured by F (curvature by default; velocity is drawn as its length), and
-saves a screenshot, by default RUN_F.png beside the run. Without a display, run it under
-xvfb-run (Debian's xvfb): `xvfb-run -a pvpython tools/paraview_render.py ...`. Exit status 2,
+saves a screenshot, by default RUN_F.png beside the run. Without a display, run it on a
+virtual X server (Debian's xvfb) with a 24-bit screen that does not reset between clients:
+`xvfb-run -a -s "-screen 0 1280x1024x24 -noreset" pvpython tools/paraview_render.py ...`
+(docs/paraview.md says why). Exit status 2,
 with one line naming what is wrong, for a file that is missing or not a run, a field the file
 does not hold or a frame it lacks; nothing is written then.
 """

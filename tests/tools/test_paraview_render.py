@@ -1,8 +1,14 @@
 #!/usr/bin/python3
 """tools/paraview_render.py (docs/paraview.md) on a tiny run of the real executable, through
-ParaView's pvpython under a virtual X server; registered only where both are installed.
+ParaView's pvpython on a virtual X server of its own; registered only where both are installed.
 
-    xvfb-run -a -s "-screen 0 1280x1024x24" test_paraview_render.py COSSERAT PVPYTHON
+    test_paraview_render.py COSSERAT PVPYTHON XVFB [unittest options]
+
+The X server picks a free display itself (-displayfd), and does not reset when its last client
+leaves (-noreset): ParaView opens and closes one connection before it opens its window's, and
+on a loaded machine the window's connection arrived while the server was resetting and was
+hung up ("bad X server connection", 7 of 8 tries beside the MPI tests,
+against 0 of 8 with -noreset).
 
 The picture of a field must show the cloth in the colour map's colours on the white
 background: curvature, signed, in both the blue and the red of Cool to Warm. A field the run did
@@ -22,6 +28,7 @@ from PIL import Image
 TOOLS = Path(__file__).resolve().parents[2] / "tools"
 COSSERAT = None
 PVPYTHON = None
+XVFB = None
 
 SCENE = """
 title = "paraview test"
@@ -50,6 +57,14 @@ nodes = [[0, 0], [0, 9]]
 class ParaViewRender(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
+        # A 24-bit screen: on xvfb-run's default 8-bit one ParaView fails (GLXBadContext).
+        read, write = os.pipe()
+        cls.xvfb = subprocess.Popen([XVFB, "-displayfd", str(write), "-screen", "0",
+                                     "1280x1024x24", "-noreset", "-nolisten", "tcp"],
+                                    pass_fds=[write], stderr=subprocess.DEVNULL)
+        os.close(write)
+        with os.fdopen(read) as display:
+            os.environ["DISPLAY"] = ":" + display.readline().strip()
         cls.directory = tempfile.TemporaryDirectory()
         cls.folder = Path(cls.directory.name)
         scene = cls.folder / "tiny.toml"
@@ -61,6 +76,8 @@ class ParaViewRender(unittest.TestCase):
     @classmethod
     def tearDownClass(cls):
         cls.directory.cleanup()
+        cls.xvfb.terminate()
+        cls.xvfb.wait()
 
     def render(self, xmf, *arguments):
         return subprocess.run([PVPYTHON, str(TOOLS / "paraview_render.py"), str(xmf),
@@ -101,8 +118,10 @@ class ParaViewRender(unittest.TestCase):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 3 or not all(os.access(p, os.X_OK) for p in sys.argv[1:3]):
-        sys.exit("usage: test_paraview_render.py COSSERAT_EXECUTABLE PVPYTHON [unittest options]")
+    if len(sys.argv) < 4 or not all(os.access(p, os.X_OK) for p in sys.argv[1:4]):
+        sys.exit("usage: test_paraview_render.py COSSERAT_EXECUTABLE PVPYTHON XVFB "
+                 "[unittest options]")
     COSSERAT = sys.argv.pop(1)
     PVPYTHON = sys.argv.pop(1)
+    XVFB = sys.argv.pop(1)
     unittest.main()
