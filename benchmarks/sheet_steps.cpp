@@ -63,7 +63,8 @@ int main(int argc, char** argv) {
     std::printf(
         "{\"nodes\": %ld, \"steps\": %ld, \"seconds\": %.6g, \"memory_bytes\": %.17g, "
         "\"rss_bytes\": %ld, \"max_rss_bytes\": %ld}\n",
-        nodes, steps, seconds, cosserat::Simulation::memory_bytes(sim.block(), scene.integrator, scene.discretisation),
+        nodes, steps, seconds,
+        cosserat::Simulation::memory_bytes(sim.block(), scene.integrator, scene.discretisation),
         resident_bytes(), usage.ru_maxrss * 1024L);
   }
   MPI_Finalize();

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,7 @@
 #include "cosserat/grid/threads.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
+#include "cosserat/io/output_fields.hpp"
 #include "cosserat/io/output_lock.hpp"
 #include "cosserat/io/stable_dt_table.hpp"
 #include "cosserat/io/summary.hpp"
@@ -133,12 +135,13 @@ class RunObserver : public cosserat::StepObserver {
       : simulation_(simulation),
         scene_(scene),
         writer_(writer),
+        fields_(simulation.block(), scene.output_fields),
         checkpoint_(checkpoint),
         progress_(progress) {}
 
   void frame() override {
     writer_.write_frame(simulation_.step_index(), simulation_.time(), simulation_.positions(),
-                        solid_poses(simulation_));
+                        solid_poses(simulation_), fields_.evaluate(simulation_));
   }
   void checkpoint(const cosserat::LoopCarry& carry) override {
     cosserat::write_checkpoint(
@@ -152,6 +155,7 @@ class RunObserver : public cosserat::StepObserver {
   cosserat::Simulation& simulation_;
   const cosserat::Scene& scene_;
   cosserat::FrameWriter& writer_;
+  cosserat::OutputFieldValues fields_;
   const std::string& checkpoint_;
   Progress& progress_;
 };
@@ -170,7 +174,12 @@ std::string describe(const cosserat::Instability& failure) {
 bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, int rank) {
   MPI_Comm node;
   MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node);
-  const double mine = cosserat::Simulation::memory_bytes(block, scene.integrator, scene.discretisation);
+  const auto scalar_fields = static_cast<std::size_t>(
+      std::ranges::count_if(scene.output_fields, [](cosserat::OutputField field) {
+        return !cosserat::node_field(field).vector;
+      }));
+  const double mine = cosserat::Simulation::memory_bytes(block, scene.integrator, scene.discretisation,
+                                                                 scalar_fields);
   double needed = 0.0;
   MPI_Allreduce(&mine, &needed, 1, MPI_DOUBLE, MPI_SUM, node);
   int node_rank = 0;
@@ -351,11 +360,12 @@ int run(const RunOptions& options, int rank, int ranks) {
           scene.adaptive ? 0 : *restarted_from - *restarted_from % scene.output_every,
           // Adaptive steps schedule frames in time.
           scene.adaptive ? AdaptiveSteps(scene).frame_at_or_before(simulation.time()) : 0.0,
-          solid_outlines(simulation, scene));
+          solid_outlines(simulation, scene), node_fields(scene.output_fields));
     else
       writer = std::make_unique<FrameWriter>(output, simulation.block(), scene.text,
                                              integrator_name(scene.integrator), COSSERAT_VERSION,
-                                             scene.overrides, solid_outlines(simulation, scene));
+                                             scene.overrides, solid_outlines(simulation, scene),
+                                             node_fields(scene.output_fields));
   } catch (const std::exception& e) {
     // This rank alone may have failed (rank 0 writes the XDMF file), and a file whose first
     // write failed crashes HDF5's clean-up in MPI_Finalize: end every rank now.
@@ -379,14 +389,11 @@ int run(const RunOptions& options, int rank, int ranks) {
       fmt::print("restarted from {} at step {}\n", options.restart, *restarted_from);
   }
 
-  // A continued file already holds every scheduled frame up to the checkpoint; a new file starts
-  // with the state the run starts from.
-  if (!continued)
-    writer->write_frame(simulation.step_index(), simulation.time(), simulation.positions(),
-                        solid_poses(simulation));
-
   Progress progress(simulation.step_index(), simulation.time(), scene.duration, on_terminal);
   RunObserver observer(simulation, scene, *writer, checkpoint, progress);
+  // A continued file already holds every scheduled frame up to the checkpoint; a new file starts
+  // with the state the run starts from.
+  if (!continued) observer.frame();
   const StepLoopResult loop = run_step_loop(
       simulation, scene,
       StepLoopOptions{options.checkpoint_every, options.until_rest, rest_peak.value_or(0.0),

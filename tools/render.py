@@ -7,7 +7,8 @@
 
 Writes one frame as a PNG (default: the most deformed frame, to FILE.png) and, with --animate,
 the run as an MP4 (through ffmpeg) or a GIF (through Pillow). The cloth is coloured by a field
-(height, strain, curvature, speed, or none) and lit from above the camera; the held nodes and
+(height, strain, curvature, speed, energy_density, or none; those the run wrote in /fields are
+read, the others computed from the positions) and lit from above the camera; the held nodes and
 loads of the scene, the solids and the floor of the file are drawn beside it. The axes and
 the colour scale are the same in every frame of an animation, and the canvas is cut to what is
 drawn. Scenes put "up" along world y, so world (x, y, z) is drawn as matplotlib (x, z, y).
@@ -111,7 +112,27 @@ FIELDS = {
     "strain": Field("area strain S/S₀ − 1 (%)", "RdBu_r", centred=True, robust=True),
     "curvature": Field("mean curvature |H| (1/m)", "YlOrRd", centred=False, robust=True),
     "speed": Field("speed (m/s)", "plasma", centred=False, robust=True),
+    "energy_density": Field("stored energy density (J/m²)", "inferno", centred=False,
+                            robust=True),
     "none": None,
+}
+
+
+@dataclass(frozen=True)
+class Stored:
+    """Where a field is read from when the file holds it: /fields/<dataset> (docs/output.md,
+    "Fields"), its node values ([frames, m, n], or [frames, m, n, components]) turned into the
+    field's by `node_values`."""
+    dataset: str
+    components: int | None
+    node_values: object
+
+
+STORED = {
+    "strain": Stored("area_ratio", None, lambda ratio: 100.0 * (ratio - 1.0)),
+    "curvature": Stored("curvature", None, np.abs),
+    "speed": Stored("velocity", 3, lambda velocity: np.linalg.norm(velocity, axis=-1)),
+    "energy_density": Stored("energy_density", None, lambda density: density),
 }
 
 
@@ -351,20 +372,20 @@ class Sheet:
         return self.frames[frame]
 
     def values(self, frame):
-        """The field's cell values [m - 1, n - 1] at `frame`: a stored /fields/<name> ([frames,
-        m, n] node values; /fields/velocity [frames, m, n, 3] for speed) when the file has one,
-        else computed from the positions (cloth_fields); None for no field."""
+        """The field's cell values [m - 1, n - 1] at `frame`, the means of their corners': from
+        the field the run wrote (STORED) when the file holds it, else computed from the
+        positions (cloth_fields); None for no field. The energy density exists only as written."""
         name, run = self.field_name, self.run
         if FIELDS[name] is None:
             return None
-        stored = run.stored_field(name)
+        source = STORED.get(name)
+        stored = run.stored_field(source.dataset, source.components) if source else None
         if stored is not None:
             nodes = np.asarray(stored[frame], dtype=float)[np.ix_(self.rows, self.columns)]
-            return cloth_fields.cell_means(nodes)
-        stored = run.stored_field("velocity", 3) if name == "speed" else None
-        if stored is not None:
-            velocity = np.asarray(stored[frame], dtype=float)[np.ix_(self.rows, self.columns)]
-            return cloth_fields.cell_means(np.linalg.norm(velocity, axis=-1))
+            return cloth_fields.cell_means(source.node_values(nodes))
+        if name == "energy_density":
+            raise InputError(f"{run.path}: no /fields/energy_density; `cosserat run` writes it "
+                             "when output.fields names it (docs/output.md)")
         points = self.points(frame)
         if name == "height":
             return cloth_fields.cell_means(points[..., 2])

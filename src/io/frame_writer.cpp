@@ -6,8 +6,10 @@
 #include <filesystem>
 #include <span>
 #include <stdexcept>
+#include <variant>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cosserat/io/xdmf.hpp"
 #include "hdf5_file.hpp"
@@ -20,21 +22,27 @@ namespace {
 
 // HDF5 refuses chunks of 4 GiB or more. One frame is one chunk, so that appending a frame
 // touches one chunk, unless the frame is that large; then it is split into bands of rows k
-// (and of columns l only if a single row is too large).
-std::array<hsize_t, 4> positions_chunk(int m, int n) {
+// (and of columns l only if a single row is too large). `components` values per node (3 for
+// the positions), or one value and no last dimension when it is 0.
+std::vector<hsize_t> node_chunk(int m, int n, hsize_t components) {
   constexpr hsize_t max_chunk_bytes = (hsize_t{1} << 32) - 1;
-  constexpr hsize_t max_nodes = max_chunk_bytes / (3 * sizeof(double));
+  const hsize_t max_nodes = max_chunk_bytes / (std::max<hsize_t>(components, 1) * sizeof(double));
   const hsize_t columns = std::min<hsize_t>(static_cast<hsize_t>(n), max_nodes);
   const hsize_t rows = std::min<hsize_t>(static_cast<hsize_t>(m), max_nodes / columns);
-  return {1, rows, columns, 3};
+  std::vector<hsize_t> chunk{1, rows, columns};
+  if (components > 0) chunk.push_back(components);
+  return chunk;
 }
 
 // Long runs write thousands of frames; a chunk of this many times or steps keeps the index of
 // the one-dimensional datasets small.
 constexpr std::array<hsize_t, 1> series_chunk{1024};
 
-std::array<hsize_t, 3> node_shape(int m, int n) {
-  return {static_cast<hsize_t>(m), static_cast<hsize_t>(n), 3};
+// The shape of one frame of a node series: [m, n, components], or [m, n] when it is 0.
+std::vector<hsize_t> node_shape(int m, int n, hsize_t components) {
+  std::vector<hsize_t> shape{static_cast<hsize_t>(m), static_cast<hsize_t>(n)};
+  if (components > 0) shape.push_back(components);
+  return shape;
 }
 
 std::string join_lines(const std::vector<std::string>& lines) {
@@ -256,6 +264,45 @@ hsize_t frames_of(const hdf5::File& file, const Handle& dataset, const std::stri
   return extent[0];
 }
 
+// --- Per-node fields (docs/output.md, "Fields"): series of the grid's shape, written like the
+// positions, each rank its block.
+
+std::string field_path(const NodeField& field) { return "/fields/" + field.name; }
+
+hsize_t components_of(const NodeField& field) { return field.vector ? 3 : 0; }
+
+void check_field_names(const std::vector<NodeField>& fields) {
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (fields[i].name == fields[j].name)
+        throw std::invalid_argument(
+            fmt::format("two output fields are named '{}'", fields[i].name));
+}
+
+Handle create_field(const hdf5::File& file, const NodeField& field, int m, int n) {
+  const std::string path = field_path(field);
+  Handle dataset = create_series(file, path.c_str(), H5T_IEEE_F64LE,
+                                 node_shape(m, n, components_of(field)),
+                                 node_chunk(m, n, components_of(field)));
+  file.write_attribute(dataset.get(), "units", field.units);
+  return dataset;
+}
+
+// The shape of a dataset's frames: its extent without the first dimension.
+std::vector<hsize_t> frame_shape_of(const hdf5::File& file, const Handle& dataset,
+                                    const std::string& what) {
+  const Handle space = file.open(H5Dget_space(dataset.get()), H5Sclose, what);
+  const int rank = file.check(H5Sget_simple_extent_ndims(space.get()), what);
+  std::vector<hsize_t> extent(static_cast<std::size_t>(rank), 0);
+  file.check(H5Sget_simple_extent_dims(space.get(), extent.data(), nullptr), what);
+  if (!extent.empty()) extent.erase(extent.begin());
+  return extent;
+}
+
+std::string field_names(const std::vector<std::string>& names) {
+  return names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "));
+}
+
 }  // namespace
 
 // Members close in reverse order: datasets before the file.
@@ -264,6 +311,7 @@ struct FrameWriter::Datasets {
   Handle time;
   Handle step;
   std::vector<SolidSeries> solids{};
+  std::vector<Handle> fields{};
 };
 
 std::string xdmf_path(const std::string& h5_path) {
@@ -273,20 +321,23 @@ std::string xdmf_path(const std::string& h5_path) {
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
                          const std::string& scene_text, const std::string& integrator,
                          const std::string& version, const std::vector<std::string>& overrides,
-                         const std::vector<SolidOutline>& solids)
+                         const std::vector<SolidOutline>& solids,
+                         const std::vector<NodeField>& fields)
     : block_(&block),
       h5_path_(h5_path),
       xmf_path_(xdmf_path(h5_path)),
       rank_(rank_in(block.comm)),
-      solids_(solids) {
+      solids_(solids),
+      fields_(fields) {
   if (block.m < 1 || block.n < 1)
     throw std::runtime_error(fmt::format("HDF5 file '{}': grid {} x {} has no nodes to write",
                                          h5_path, block.m, block.n));
   for (std::size_t i = 0; i < solids.size(); ++i) check_outline(solids[i], i);
+  check_field_names(fields);
   file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::create);
   datasets_ = std::make_unique<Datasets>(Datasets{
-      create_series(*file_, "/positions", H5T_IEEE_F64LE, node_shape(block.m, block.n),
-                    positions_chunk(block.m, block.n)),
+      create_series(*file_, "/positions", H5T_IEEE_F64LE, node_shape(block.m, block.n, 3),
+                    node_chunk(block.m, block.n, 3)),
       create_series(*file_, "/time", H5T_IEEE_F64LE, {}, series_chunk),
       create_series(*file_, "/step", H5T_STD_I64LE, {}, series_chunk)});
   file_->write_attribute("scene", scene_text);
@@ -296,17 +347,23 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block,
   if (!solids.empty()) create_group(*file_, "/solids");
   for (std::size_t i = 0; i < solids.size(); ++i)
     datasets_->solids.push_back(create_solid(*file_, i, solids[i], rank_ == 0));
+  if (!fields.empty()) create_group(*file_, "/fields");
+  for (const NodeField& field : fields)
+    datasets_->fields.push_back(create_field(*file_, field, block.m, block.n));
   file_->flush();
 }
 
 FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long step,
                          const std::string& scene_text, long last_scheduled_frame,
-                         double last_scheduled_time, const std::vector<SolidOutline>& solids)
+                         double last_scheduled_time, const std::vector<SolidOutline>& solids,
+                         const std::vector<NodeField>& fields)
     : block_(&block),
       h5_path_(h5_path),
       xmf_path_(xdmf_path(h5_path)),
       rank_(rank_in(block.comm)),
-      solids_(solids) {
+      solids_(solids),
+      fields_(fields) {
+  check_field_names(fields);
   file_ = std::make_unique<hdf5::File>(h5_path, block.comm, hdf5::File::Mode::read_write);
   const std::string what = "reopen for a restart";
   auto open = [&](const char* name) {
@@ -381,6 +438,45 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
                                             open((group + "/orientation").c_str()),
                                             open((group + "/world_vertices").c_str())});
   }
+  // The same fields, each of this grid's shape and in the same units: another --set
+  // output.fields than the run's would leave some series a frame short or without frames.
+  {
+    std::vector<std::string> held;
+    if (file_->check(H5Lexists(file_->get(), "fields", H5P_DEFAULT), what) > 0) {
+      H5G_info_t info{};
+      file_->check(H5Gget_info_by_name(file_->get(), "fields", &info, H5P_DEFAULT), what);
+      for (hsize_t i = 0; i < info.nlinks; ++i) {
+        const ssize_t size = H5Lget_name_by_idx(file_->get(), "fields", H5_INDEX_NAME,
+                                                H5_ITER_INC, i, nullptr, 0, H5P_DEFAULT);
+        file_->check(static_cast<hid_t>(size), what + " (field names)");
+        std::string name(static_cast<std::size_t>(size) + 1, '\0');
+        file_->check(H5Lget_name_by_idx(file_->get(), "fields", H5_INDEX_NAME, H5_ITER_INC, i,
+                                        name.data(), name.size(), H5P_DEFAULT),
+                     what + " (field names)");
+        name.resize(static_cast<std::size_t>(size));
+        held.push_back(name);
+      }
+    }
+    std::vector<std::string> wanted;
+    for (const NodeField& field : fields) wanted.push_back(field.name);
+    std::vector<std::string> wanted_sorted = wanted;
+    std::ranges::sort(wanted_sorted);
+    if (held != wanted_sorted)
+      refuse(fmt::format("it holds the fields {} and this run writes {} (output.fields, or its "
+                         "default by the grid's size: docs/output.md)",
+                         field_names(held), field_names(wanted_sorted)));
+  }
+  for (const NodeField& field : fields) {
+    const std::string path = field_path(field);
+    Handle dataset = open(path.c_str());
+    if (frame_shape_of(*file_, dataset, what) != node_shape(block.m, block.n, components_of(field)))
+      refuse(fmt::format("its {} is not of this grid's shape", path));
+    if (file_->read_string_attribute(dataset.get(), "units") != field.units)
+      refuse(fmt::format("its {} is in '{}', this run's in '{}'", path,
+                         file_->read_string_attribute(dataset.get(), "units"), field.units));
+    datasets_->fields.push_back(std::move(dataset));
+  }
+
   auto check_frames = [&](const Handle& dataset, const std::string& name) {
     const hsize_t frames = frames_of(*file_, dataset, what);
     if (frames < kept)
@@ -393,6 +489,8 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
     check_frames(solid.orientation, solid_group(i) + "/orientation");
     check_frames(solid.world_vertices, solid_group(i) + "/world_vertices");
   }
+  for (std::size_t i = 0; i < fields.size(); ++i)
+    check_frames(datasets_->fields[i], field_path(fields[i]));
 
   resize_series(*file_, datasets_->positions, kept, what);
   resize_series(*file_, datasets_->time, kept, what);
@@ -402,24 +500,34 @@ FrameWriter::FrameWriter(const std::string& h5_path, const Block& block, long st
     resize_series(*file_, solid.orientation, kept, what);
     resize_series(*file_, solid.world_vertices, kept, what);
   }
+  for (const Handle& field : datasets_->fields) resize_series(*file_, field, kept, what);
   file_->write_attribute("status", std::string("running (restarted)"));
   file_->flush();
   // Written whole once, for the frames kept: it may describe the dropped ones, or be the partial
   // file of a run killed while appending.
   if (rank_ == 0)
     xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block.m, block.n, times_,
-                                       xdmf_solids());
+                                       xdmf_solids(), xdmf_fields());
 }
 
 FrameWriter::~FrameWriter() = default;
 
 void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positions,
-                              const std::vector<Pose>& solid_poses) {
+                              const std::vector<Pose>& solid_poses,
+                              const std::vector<NodeFieldValues>& field_values) {
   const auto frame = static_cast<hsize_t>(steps_.size());
   const std::string what = fmt::format("write frame {}", frame);
   if (solid_poses.size() != solids_.size())
     throw std::invalid_argument(fmt::format("HDF5 file '{}': {}: {} solid poses for {} solids",
                                             h5_path_, what, solid_poses.size(), solids_.size()));
+  if (field_values.size() != fields_.size())
+    throw std::invalid_argument(fmt::format("HDF5 file '{}': {}: {} field values for {} fields",
+                                            h5_path_, what, field_values.size(), fields_.size()));
+  for (std::size_t i = 0; i < fields_.size(); ++i)
+    if (std::holds_alternative<const Field<Vec3>*>(field_values[i]) != fields_[i].vector)
+      throw std::invalid_argument(fmt::format(
+          "HDF5 file '{}': {}: field '{}' is a {}, given a {}", h5_path_, what, fields_[i].name,
+          fields_[i].vector ? "vector" : "scalar", fields_[i].vector ? "scalar" : "vector"));
   const std::int64_t step_value = step;
   resize_series(*file_, datasets_->positions, frame + 1, what);
   resize_series(*file_, datasets_->time, frame + 1, what);
@@ -429,8 +537,16 @@ void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positio
     resize_series(*file_, solid.orientation, frame + 1, what);
     resize_series(*file_, solid.world_vertices, frame + 1, what);
   }
+  for (const Handle& field : datasets_->fields) resize_series(*file_, field, frame + 1, what);
   const std::array<hsize_t, 1> at{frame};
   file_->write_block(datasets_->positions.get(), positions, at, what + " of /positions");
+  for (std::size_t i = 0; i < fields_.size(); ++i)
+    std::visit(
+        [&](const auto* values) {
+          file_->write_block(datasets_->fields[i].get(), *values, at,
+                             what + " of " + field_path(fields_[i]));
+        },
+        field_values[i]);
   write_series_value(*file_, datasets_->time, frame, H5T_NATIVE_DOUBLE, &time, rank_ == 0,
                      what + " of /time");
   write_series_value(*file_, datasets_->step, frame, H5T_NATIVE_INT64, &step_value, rank_ == 0,
@@ -463,7 +579,7 @@ void FrameWriter::write_frame(long step, double time, const Field<Vec3>& positio
     xdmf_->append(time);
   else
     xdmf_ = std::make_unique<XdmfFile>(xmf_path_, h5_filename(), block_->m, block_->n, times_,
-                                       xdmf_solids());
+                                       xdmf_solids(), xdmf_fields());
 }
 
 std::vector<XdmfSolid> FrameWriter::xdmf_solids() const {
@@ -472,6 +588,12 @@ std::vector<XdmfSolid> FrameWriter::xdmf_solids() const {
     solids.push_back(XdmfSolid{solid.name, static_cast<long>(solid.surface.vertices.size()),
                                static_cast<long>(solid.surface.triangles.size())});
   return solids;
+}
+
+std::vector<XdmfField> FrameWriter::xdmf_fields() const {
+  std::vector<XdmfField> fields;
+  for (const NodeField& field : fields_) fields.push_back(XdmfField{field.name, field.vector});
+  return fields;
 }
 
 std::string FrameWriter::h5_filename() const {

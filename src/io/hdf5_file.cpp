@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <optional>
 #include <stdexcept>
@@ -170,13 +171,14 @@ double File::read_double_attribute(const std::string& name) const {
 
 namespace {
 
-// The block's slab of an [frames...][m][n][3] dataset and a matching memory space.
+// The block's slab of an [frames...][m][n][components] dataset (no last dimension when
+// `components` is 0) and a matching memory space.
 struct Slab {
   Handle file_space, memory_space;
 };
 
 Slab block_slab(const File& file, hid_t dataset, const Block& b, std::span<const hsize_t> frame,
-                const std::string& what) {
+                hsize_t components, const std::string& what) {
   std::array<hsize_t, 4> start{}, count{};
   std::size_t d = 0;
   for (const hsize_t f : frame) {
@@ -187,8 +189,10 @@ Slab block_slab(const File& file, hid_t dataset, const Block& b, std::span<const
   count[d++] = static_cast<hsize_t>(b.owned_k());
   start[d] = static_cast<hsize_t>(b.l0);
   count[d++] = static_cast<hsize_t>(b.owned_l());
-  start[d] = 0;
-  count[d++] = 3;
+  if (components > 0) {
+    start[d] = 0;
+    count[d++] = components;
+  }
   Slab slab{file.open(H5Dget_space(dataset), H5Sclose, what),
             file.open(H5Screate_simple(static_cast<int>(d), count.data(), nullptr), H5Sclose, what)};
   file.check(H5Sselect_hyperslab(slab.file_space.get(), H5S_SELECT_SET, start.data(), nullptr,
@@ -197,35 +201,49 @@ Slab block_slab(const File& file, hid_t dataset, const Block& b, std::span<const
   return slab;
 }
 
+// Values per node of a field as the file holds them: three for a vector, one (and no last
+// dimension) for a scalar.
+template <class T>
+constexpr hsize_t components_of = 0;
+template <>
+constexpr hsize_t components_of<Vec3> = 3;
+
+void append(std::vector<double>& values, double value) { values.push_back(value); }
+void append(std::vector<double>& values, const Vec3& p) {
+  values.insert(values.end(), {p.x, p.y, p.z});
+}
+
 // The file's order is l fastest, the field's k fastest: one transposing copy each way.
-std::vector<double> owned_nodes(const Field<Vec3>& field) {
+template <class T>
+void write_owned(const File& file, hid_t dataset, const Field<T>& field,
+                 std::span<const hsize_t> frame, const std::string& what) {
   const Block& b = field.block();
-  std::vector<double> out(3 * static_cast<std::size_t>(b.owned_k()) * b.owned_l());
-  std::size_t at = 0;
+  const Slab slab = block_slab(file, dataset, b, frame, components_of<T>, what);
+  std::vector<double> values;
+  values.reserve(std::max<std::size_t>(components_of<T>, 1) *
+                 static_cast<std::size_t>(b.owned_k()) * b.owned_l());
   for (int k = b.k0; k < b.k1; ++k)
-    for (int l = b.l0; l < b.l1; ++l) {
-      const Vec3 p = field(k, l);
-      out[at++] = p.x;
-      out[at++] = p.y;
-      out[at++] = p.z;
-    }
-  return out;
+    for (int l = b.l0; l < b.l1; ++l) append(values, field(k, l));
+  file.check(H5Dwrite(dataset, H5T_NATIVE_DOUBLE, slab.memory_space.get(), slab.file_space.get(),
+                      file.collective(), values.data()),
+             what);
 }
 
 }  // namespace
 
 void File::write_block(hid_t dataset, const Field<Vec3>& field, std::span<const hsize_t> frame,
                        const std::string& what) const {
-  const Slab slab = block_slab(*this, dataset, field.block(), frame, what);
-  const std::vector<double> values = owned_nodes(field);
-  check(H5Dwrite(dataset, H5T_NATIVE_DOUBLE, slab.memory_space.get(), slab.file_space.get(),
-                 collective(), values.data()),
-        what);
+  write_owned(*this, dataset, field, frame, what);
+}
+
+void File::write_block(hid_t dataset, const Field<double>& field, std::span<const hsize_t> frame,
+                       const std::string& what) const {
+  write_owned(*this, dataset, field, frame, what);
 }
 
 void File::read_block(hid_t dataset, Field<Vec3>& field, const std::string& what) const {
   const Block& b = field.block();
-  const Slab slab = block_slab(*this, dataset, b, {}, what);
+  const Slab slab = block_slab(*this, dataset, b, {}, components_of<Vec3>, what);
   std::vector<double> values(3 * static_cast<std::size_t>(b.owned_k()) * b.owned_l());
   check(H5Dread(dataset, H5T_NATIVE_DOUBLE, slab.memory_space.get(), slab.file_space.get(),
                 collective(), values.data()),

@@ -2,7 +2,7 @@
 // What the output writer and the checkpoints share: an HDF5 file opened by every rank of a
 // communicator through MPI-IO, handles that close themselves, failures as exceptions naming the
 // file, and the collective write and read of a block's nodes as its hyperslab of an [m][n][3]
-// array. Private to src/io: hdf5.h stays out of the public headers.
+// (or [m][n]) array. Private to src/io: hdf5.h stays out of the public headers.
 
 #include <hdf5.h>
 
@@ -96,6 +96,9 @@ class File {
   // Every rank writes (reads) its block's owned nodes as the slab [k0:k1, l0:l1, 0:3] of the
   // dataset, at index `frame` of a leading frame dimension when the dataset has one.
   void write_block(hid_t dataset, const Field<Vec3>& field, std::span<const hsize_t> frame,
+                   const std::string& what) const;
+  // The same for one value per node: the slab [k0:k1, l0:l1] of an [frames...][m][n] dataset.
+  void write_block(hid_t dataset, const Field<double>& field, std::span<const hsize_t> frame,
                    const std::string& what) const;
   void read_block(hid_t dataset, Field<Vec3>& field, const std::string& what) const;
 

@@ -446,4 +446,12 @@ double CosseratEnergy::block_energy(const Field<Vec3>& r) const {
   return total;
 }
 
+void CosseratEnergy::energy_density(const Field<Vec3>& r, Field<double>& density) const {
+  const Block& b = *block_;
+  const double area = h1_ * h2_;
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) density(k, l) = node_energy(r, k, l, nullptr) / area;
+}
+
 }  // namespace cosserat

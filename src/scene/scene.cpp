@@ -461,6 +461,36 @@ void read_time(const Table& time, Scene& scene) {
   }
 }
 
+// [output] fields = [...]: each name once, any order; without it every field on a grid of at
+// most kOutputFieldsDefaultMaxNodes nodes and none on a larger one. Read after the grid.
+void read_output(const std::optional<Table>& output, Scene& scene) {
+  const std::vector<OutputField> every = all_output_fields();
+  std::vector<std::string> names;
+  for (const OutputField field : every) names.emplace_back(output_field_name(field));
+  std::optional<Entry> fields;
+  if (output) {
+    output->allow({"fields"});
+    fields = output->find("fields");
+  }
+  if (!fields) {
+    if (static_cast<long>(scene.m) * scene.n <= kOutputFieldsDefaultMaxNodes)
+      scene.output_fields = every;
+    return;
+  }
+  std::vector<bool> chosen(every.size(), false);
+  for (const Entry& entry : fields->elements(0, "an array of field names")) {
+    const std::string name = entry.string();
+    const auto at = std::ranges::find(names, name);
+    if (at == names.end())
+      entry.fail(fmt::format("unknown field \"{}\"; allowed: {}", name, joined(names)));
+    const auto index = static_cast<std::size_t>(at - names.begin());
+    if (chosen[index]) entry.fail(fmt::format("\"{}\" is named twice", name));
+    chosen[index] = true;
+  }
+  for (std::size_t i = 0; i < every.size(); ++i)
+    if (chosen[i]) scene.output_fields.push_back(every[i]);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Node sets: a list of [k, l] pairs or a region in grid index space
 
@@ -675,7 +705,8 @@ void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
 
 void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   root.allow(
-      {"title", "grid", "material", "model", "environment", "time", "fix", "load", "solid"});
+      {"title", "grid", "material", "model", "environment", "time", "output", "fix", "load",
+       "solid"});
   if (const auto title = root.find("title")) scene.title = title->string();
   // Grid first: the material's mass and every node set depend on it.
   read_grid(root.require_table("grid", "a [grid] table with nodes and size"), scene);
@@ -688,6 +719,7 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
     read_environment(*environment, scene);
   }
   read_time(root.require_table("time", "a [time] table with dt and steps, or a duration"), scene);
+  read_output(root.find_table("output"), scene);
   if (const auto fixes = root.find("fix")) {
     for (const auto& block : fixes->tables("fix")) scene.fixes.push_back(read_fix(block, scene));
   }
@@ -701,6 +733,21 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
 }
 
 }  // namespace
+
+const char* output_field_name(OutputField field) {
+  switch (field) {
+    case OutputField::velocity: return "velocity";
+    case OutputField::area_ratio: return "area_ratio";
+    case OutputField::curvature: return "curvature";
+    case OutputField::energy_density: return "energy_density";
+  }
+  return "";
+}
+
+std::vector<OutputField> all_output_fields() {
+  return {OutputField::velocity, OutputField::area_ratio, OutputField::curvature,
+          OutputField::energy_density};
+}
 
 Scene parse_scene(const std::string& text, const std::string& path,
                   const std::vector<std::string>& overrides) {

@@ -277,10 +277,16 @@ TEST_F(Cli, BlowUpStopsWithItsOwnStatusAndKeepsWork) {
   EXPECT_THAT(json.str(), ::testing::Not(HasSubstr("\"unstable_step\": null")));
 }
 
-// /positions, /time and /step of an output file as raw bytes.
+// The per-node fields a small grid writes by default (docs/output.md, "Fields").
+constexpr std::array<const char*, 4> kFieldDatasets{"/fields/velocity", "/fields/area_ratio",
+                                                    "/fields/curvature", "/fields/energy_density"};
+
+// /positions, /time, /step and the fields of an output file as raw bytes, in that order.
 std::vector<std::vector<unsigned char>> read_datasets(const std::string& file) {
   std::vector<std::vector<unsigned char>> all;
   for (const char* name : {"/positions", "/time", "/step"})
+    all.push_back(cosserat::testing::dataset_bytes(file, name));
+  for (const char* name : kFieldDatasets)
     all.push_back(cosserat::testing::dataset_bytes(file, name));
   return all;
 }
@@ -370,6 +376,10 @@ TEST_F(Cli, KilledRunRestartsToTheUninterruptedOutput) {
   EXPECT_TRUE(killed[0] == whole[0]) << "/positions differ";
   EXPECT_TRUE(killed[1] == whole[1]) << "/time differs";
   EXPECT_TRUE(killed[2] == whole[2]) << "/step differs";
+  for (std::size_t i = 0; i < kFieldDatasets.size(); ++i) {
+    EXPECT_FALSE(whole[3 + i].empty()) << kFieldDatasets[i];
+    EXPECT_TRUE(killed[3 + i] == whole[3 + i]) << kFieldDatasets[i] << " differs";
+  }
 }
 
 // Issue 12, defect 13: the XDMF file grows by one element per frame, in place. A run killed
@@ -395,6 +405,78 @@ TEST_F(Cli, XdmfOfAKilledRunParsesAndNamesItsFrames) {
   EXPECT_TRUE(named == frames || named == frames - 1) << named << " named, " << frames << " held";
 }
 
+// The shape of a dataset, and its `units` attribute; empty when it is absent.
+std::pair<std::vector<hsize_t>, std::string> shape_and_units(const std::string& file,
+                                                             const char* name) {
+  std::pair<std::vector<hsize_t>, std::string> found;
+  const hid_t f = H5Fopen(file.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return found;
+  if (H5Lexists(f, "fields", H5P_DEFAULT) > 0 && H5Lexists(f, name, H5P_DEFAULT) > 0) {
+    const hid_t d = H5Dopen2(f, name, H5P_DEFAULT);
+    const hid_t s = H5Dget_space(d);
+    found.first.resize(static_cast<std::size_t>(H5Sget_simple_extent_ndims(s)));
+    H5Sget_simple_extent_dims(s, found.first.data(), nullptr);
+    const hid_t a = H5Aopen(d, "units", H5P_DEFAULT);
+    const hid_t type = H5Aget_type(a);
+    char* text = nullptr;
+    H5Aread(a, type, &text);
+    found.second = text != nullptr ? text : "";
+    H5free_memory(text);
+    H5Tclose(type);
+    H5Aclose(a);
+    H5Sclose(s);
+    H5Dclose(d);
+  }
+  H5Fclose(f);
+  return found;
+}
+
+long xdmf_attributes(const std::string& file) {
+  std::stringstream text;
+  text << std::ifstream(file).rdbuf();
+  long count = 0;
+  const std::string xml = text.str();
+  for (auto at = xml.find("<Attribute "); at != std::string::npos;
+       at = xml.find("<Attribute ", at + 1))
+    ++count;
+  return count;
+}
+
+// A small grid writes every field by default, each with its units and named in every frame of
+// the XDMF file; output.fields chooses, and a name it does not know is bad input.
+TEST_F(Cli, SmallGridsWriteEveryFieldAndOutputFieldsChooses) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  ASSERT_EQ(cosserat("run " + scene + " -q -o " + path("all.h5")).status, 0);
+  using Shape = std::vector<hsize_t>;
+  EXPECT_EQ(shape_and_units(path("all.h5"), "/fields/velocity"),
+            std::pair(Shape{5, 6, 6, 3}, std::string("m/s")));
+  EXPECT_EQ(shape_and_units(path("all.h5"), "/fields/area_ratio"),
+            std::pair(Shape{5, 6, 6}, std::string("1")));
+  EXPECT_EQ(shape_and_units(path("all.h5"), "/fields/curvature"),
+            std::pair(Shape{5, 6, 6}, std::string("1/m")));
+  EXPECT_EQ(shape_and_units(path("all.h5"), "/fields/energy_density"),
+            std::pair(Shape{5, 6, 6}, std::string("J/m^2")));
+  EXPECT_EQ(xdmf_attributes(path("all.xmf")), 4 * 5);
+
+  ASSERT_EQ(cosserat("run " + scene + " -q --set output.fields=[] -o " + path("none.h5")).status, 0);
+  EXPECT_TRUE(shape_and_units(path("none.h5"), "/fields/velocity").first.empty());
+  EXPECT_EQ(xdmf_attributes(path("none.xmf")), 0);
+  ASSERT_EQ(cosserat("run " + scene + " -q --set 'output.fields=[\"curvature\"]' -o " +
+                     path("one.h5"))
+                .status,
+            0);
+  EXPECT_TRUE(shape_and_units(path("one.h5"), "/fields/velocity").first.empty());
+  EXPECT_EQ(shape_and_units(path("one.h5"), "/fields/curvature").first, (Shape{5, 6, 6}));
+  EXPECT_EQ(xdmf_attributes(path("one.xmf")), 5);
+
+  const Result bad = cosserat("run " + scene + " --set 'output.fields=[\"speed\"]' -o " +
+                              path("bad.h5"));
+  EXPECT_EQ(bad.status, 2) << bad.output;
+  EXPECT_THAT(bad.output, HasSubstr("key 'output.fields[0]': unknown field \"speed\"; allowed: "
+                                    "velocity, area_ratio, curvature, energy_density"));
+  EXPECT_FALSE(fs::exists(path("bad.h5")));
+}
+
 TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=10 --checkpoint-every 10 -o " + path("a.h5")).status, 0);
@@ -410,6 +492,20 @@ TEST_F(Cli, RestartFromAnotherScenesCheckpointIsBadInput) {
 std::string on_ranks(int ranks, const std::string& arguments) {
   return std::string(COSSERAT_MPIEXEC) + " -n " + std::to_string(ranks) + " " +
          COSSERAT_MPIEXEC_FLAGS + " " + COSSERAT_EXE + " " + arguments;
+}
+
+// The whole output of 4 ranks, fields included, is that of one, dataset by dataset.
+TEST_F(Cli, OutputOfFourRanksIsThatOfOne) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string grid = " --set grid.nodes=[13,11] -q --threads 1 -o ";
+  ASSERT_EQ(cosserat("run " + scene + grid + path("one.h5")).status, 0);
+  const Result four = shell(on_ranks(4, "run " + scene + grid + path("four.h5")));
+  ASSERT_EQ(four.status, 0) << four.output;
+  const auto one_rank = read_datasets(path("one.h5")), four_ranks = read_datasets(path("four.h5"));
+  for (std::size_t i = 0; i < one_rank.size(); ++i) {
+    EXPECT_FALSE(one_rank[i].empty()) << i;
+    EXPECT_TRUE(one_rank[i] == four_ranks[i]) << "dataset " << i << " differs";
+  }
 }
 
 TEST_F(Cli, GridTooSmallForTheRanksIsBadInput) {

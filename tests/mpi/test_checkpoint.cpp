@@ -13,11 +13,13 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/io/checkpoint.hpp"
 #include "cosserat/io/frame_writer.hpp"
+#include "cosserat/io/output_fields.hpp"
 #include "cosserat/time/step_loop.hpp"
 #include "mpi_support.hpp"
 #include "support/dataset_bytes.hpp"
@@ -276,6 +278,52 @@ TEST_F(Output, OfPRanksReadsBackEqualToOneRank) {
     }
   MPI_Bcast(&equal, 1, MPI_INT, 0, MPI_COMM_WORLD);
   EXPECT_TRUE(equal) << "P = " << world_size();
+}
+
+// The per-node fields (docs/output.md, "Fields") of P ranks, each computed on its block from the
+// positions and their ghosts and written as its hyperslab, equal one rank's bit for bit; in
+// both forms (the flux form's energy density is the energy form's formula at its positions),
+// for a scheme that carries velocities and one that derives them.
+TEST_F(Output, FieldsOfPRanksReadBackEqualToOneRank) {
+  for (const auto& [integrator, discretisation] :
+       {std::pair{Integrator::verlet, Discretisation::energy},
+        std::pair{Integrator::rk4, Discretisation::flux}}) {
+    Scene scene = testing::odd_grid_scene(integrator);
+    scene.discretisation = discretisation;
+    ASSERT_EQ(scene.output_fields, all_output_fields());
+    const std::string tag = std::string(discretisation_name(discretisation));
+    const std::string parallel = (folder_ / ("parallel_fields_" + tag + ".h5")).string();
+    const std::string serial = (folder_ / ("serial_fields_" + tag + ".h5")).string();
+    auto run = [&](const std::string& path, MPI_Comm comm) {
+      Simulation sim(scene, comm, any_scheme);
+      OutputFieldValues fields(sim.block(), scene.output_fields);
+      FrameWriter writer(path, sim.block(), scene.text, "verlet", "test", {}, {},
+                         node_fields(scene.output_fields));
+      writer.write_frame(sim.step_index(), sim.time(), sim.positions(), {}, fields.evaluate(sim));
+      for (int frame = 0; frame < 3; ++frame) {
+        testing::advance(sim, scene.output_every);
+        writer.write_frame(sim.step_index(), sim.time(), sim.positions(), {},
+                           fields.evaluate(sim));
+      }
+    };
+    run(parallel, MPI_COMM_WORLD);
+    if (world_rank() == 0) run(serial, MPI_COMM_SELF);
+    MPI_Barrier(MPI_COMM_WORLD);
+
+    int equal = 1;
+    if (world_rank() == 0)
+      for (const OutputField field : all_output_fields()) {
+        const std::string name = std::string("/fields/") + output_field_name(field);
+        const auto a = dataset_bytes(parallel, name.c_str());
+        const auto b = dataset_bytes(serial, name.c_str());
+        EXPECT_EQ(a.size(), 4 * 37 * 23 * sizeof(double) * (field == OutputField::velocity ? 3 : 1))
+            << name << ", " << tag;
+        EXPECT_EQ(a, b) << name << ", " << tag;
+        equal = equal && !a.empty() && a == b;
+      }
+    MPI_Bcast(&equal, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    EXPECT_TRUE(equal) << "P = " << world_size() << ", " << tag;
+  }
 }
 
 // Rigid solids are replicated on every rank and written by rank 0, inside the same collective

@@ -147,12 +147,49 @@ class Renderer(unittest.TestCase):
                                *map(str, arguments)], capture_output=True, text=True)
 
     def test_a_picture_for_every_field(self):
-        for field in ("height", "strain", "curvature", "speed", "none"):
+        for field in ("height", "strain", "curvature", "speed", "energy_density", "none"):
             with self.subTest(field=field):
                 picture = self.folder / f"{field}.png"
                 result = self.render("--field", field, "--output", picture)
                 self.assertEqual(result.returncode, 0, result.stderr)
                 self.assertEqual(picture.read_bytes()[:8], b"\x89PNG\r\n\x1a\n")
+
+    def test_fields_are_computed_when_the_run_wrote_none(self):
+        scene = self.folder / "tiny.toml"
+        bare = self.folder / "bare.h5"
+        subprocess.run([COSSERAT, "run", str(scene), "--output", str(bare), "--quiet",
+                        "--threads", "1", "--set", "output.fields=[]"], check=True,
+                       cwd=self.folder)
+        for field in ("strain", "curvature", "speed"):
+            with self.subTest(field=field):
+                picture = self.folder / f"bare_{field}.png"
+                result = subprocess.run([sys.executable, str(TOOLS / "render.py"), str(bare),
+                                         "--field", field, "--output", str(picture)],
+                                        capture_output=True, text=True)
+                self.assertEqual(result.returncode, 0, result.stderr)
+                self.assertTrue(picture.exists())
+        picture = self.folder / "bare_energy.png"
+        result = subprocess.run([sys.executable, str(TOOLS / "render.py"), str(bare), "--field",
+                                 "energy_density", "--output", str(picture)],
+                                capture_output=True, text=True)
+        self.assertEqual(result.returncode, 2)
+        self.assertIn("no /fields/energy_density", result.stderr)
+        self.assertFalse(picture.exists())
+
+    def test_stored_fields_are_the_ones_drawn(self):
+        import h5py
+        sys.path.insert(0, str(TOOLS))
+        import render
+        with h5py.File(self.run_file, "r") as h5:
+            run = render.Run(h5, self.run_file)
+            frame = run.frames - 1
+            curvature = render.Sheet(run, "curvature").values(frame)
+            nodes = np.abs(h5["fields/curvature"][frame])
+            np.testing.assert_allclose(curvature, cloth_fields.cell_means(nodes), rtol=1e-12)
+            strain = render.Sheet(run, "strain").values(frame)
+            ratio = h5["fields/area_ratio"][frame]
+            np.testing.assert_allclose(strain, cloth_fields.cell_means(100.0 * (ratio - 1.0)),
+                                       rtol=1e-12)
 
     def test_a_gif_of_every_frame(self):
         from PIL import Image

@@ -591,6 +591,134 @@ TEST_F(FrameWriterTest, RestartCutsTheSolidsWithTheCloth) {
   }
 }
 
+// One value per node, distinct per frame, node and field, as a scalar output field takes it.
+Field<double> scalar_field(const Block& block, int frame, double offset) {
+  Field<double> field(block);
+  for (int k = 0; k < block.m; ++k)
+    for (int l = 0; l < block.n; ++l)
+      field(k, l) = offset + frame * 100.0 + k + l * 0.01 + 1.0 / 7.0;
+  return field;
+}
+
+const std::vector<NodeField> kFields{{"velocity", "m/s", true}, {"curvature", "1/m", false}};
+
+std::string dataset_units(hid_t file, const char* name) {
+  const Hid dataset(H5Dopen2(file, name, H5P_DEFAULT), H5Dclose);
+  return read_string_attribute(dataset.get(), "units");
+}
+
+// Each field is a series of the grid's shape beside /positions, in the same [k][l] order, with
+// its units; the XDMF file names each as a node attribute of every frame.
+TEST_F(FrameWriterTest, WritesFieldsBesideThePositions) {
+  const fs::path h5 = directory_ / "fields.h5";
+  const Block block = Block::whole(3, 4, MPI_COMM_SELF);
+  std::vector<double> times;
+  {
+    FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {}, {}, kFields);
+    for (int frame = 0; frame < 3; ++frame) {
+      const Field<Vec3> velocity = frame_field(block, frame + 7);
+      const Field<double> curvature = scalar_field(block, frame, 0.5);
+      times.push_back(frame * 0.25);
+      writer.write_frame(frame * 10, times.back(), frame_field(block, frame), {},
+                         {&velocity, &curvature});
+    }
+    const Field<double> curvature = scalar_field(block, 0, 0.0);
+    EXPECT_THROW(writer.write_frame(30, 1.0, frame_field(block, 3), {}, {&curvature}),
+                 std::invalid_argument);
+    EXPECT_THROW(writer.write_frame(30, 1.0, frame_field(block, 3), {}, {&curvature, &curvature}),
+                 std::invalid_argument);
+    EXPECT_EQ(writer.frames(), 3);
+  }
+  const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  EXPECT_EQ(dataset_shape(file.get(), "/fields/velocity"), (std::vector<hsize_t>{3, 3, 4, 3}));
+  EXPECT_EQ(dataset_shape(file.get(), "/fields/curvature"), (std::vector<hsize_t>{3, 3, 4}));
+  EXPECT_EQ(dataset_units(file.get(), "/fields/velocity"), "m/s");
+  EXPECT_EQ(dataset_units(file.get(), "/fields/curvature"), "1/m");
+  std::vector<double> velocity, curvature;
+  for (int frame = 0; frame < 3; ++frame) {
+    const std::vector<double> v = frame_positions(3, 4, frame + 7);
+    velocity.insert(velocity.end(), v.begin(), v.end());
+    const Field<double> c = scalar_field(block, frame, 0.5);
+    for (int k = 0; k < 3; ++k)
+      for (int l = 0; l < 4; ++l) curvature.push_back(c(k, l));
+  }
+  EXPECT_EQ(read_all<double>(file.get(), "/fields/velocity", H5T_NATIVE_DOUBLE), velocity);
+  EXPECT_EQ(read_all<double>(file.get(), "/fields/curvature", H5T_NATIVE_DOUBLE), curvature);
+
+  const std::string xmf = read_text(directory_ / "fields.xmf");
+  EXPECT_EQ(xmf, xdmf_document("fields.h5", 3, 4, times, {},
+                               {{"velocity", true}, {"curvature", false}}));
+  EXPECT_EQ(count_occurrences(
+                xmf, R"(<Attribute Name="velocity" AttributeType="Vector" Center="Node">)"),
+            3);
+  EXPECT_EQ(count_occurrences(
+                xmf, R"(<Attribute Name="curvature" AttributeType="Scalar" Center="Node">)"),
+            3);
+  EXPECT_NE(xmf.find(">fields.h5:/fields/velocity|2 0 0 0:1 1 1 1:1 3 4 3:3 3 4 3<"),
+            std::string::npos) << xmf;
+  EXPECT_NE(xmf.find(">fields.h5:/fields/curvature|1 0 0:1 1 1:1 3 4:2 3 4<"), std::string::npos)
+      << xmf;
+}
+
+TEST_F(FrameWriterTest, WithoutFieldsTheFileHasNoFieldsGroup) {
+  const fs::path h5 = directory_ / "plain.h5";
+  const Block block = Block::whole(3, 2, MPI_COMM_SELF);
+  {
+    FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {});
+    writer.write_frame(0, 0.0, frame_field(block, 0));
+  }
+  const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  EXPECT_EQ(H5Lexists(file.get(), "fields", H5P_DEFAULT), 0);
+  EXPECT_EQ(read_text(directory_ / "plain.xmf").find("<Attribute"), std::string::npos);
+  EXPECT_THROW(FrameWriter((directory_ / "twice.h5").string(), block, "scene", "verlet", "0.1.0",
+                           {}, {}, {kFields[1], kFields[1]}),
+               std::invalid_argument);
+}
+
+// A restart keeps the fields' frames up to the checkpoint with the cloth's; a file of other
+// fields (another output.fields) is refused and left as it was.
+TEST_F(FrameWriterTest, RestartCutsTheFieldsWithTheCloth) {
+  const fs::path h5 = directory_ / "resume_fields.h5";
+  const Block block = Block::whole(3, 2, MPI_COMM_SELF);
+  const Field<Vec3> velocity = frame_field(block, 9);
+  const Field<double> curvature = scalar_field(block, 1, 0.0);
+  std::vector<double> times;
+  {
+    FrameWriter writer(h5.string(), block, "scene", "verlet", "0.1.0", {}, {}, kFields);
+    for (int frame = 0; frame < 5; ++frame) {
+      times.push_back(frame * 0.5);
+      writer.write_frame(frame * 10, times.back(), frame_field(block, frame), {},
+                         {&velocity, &curvature});
+    }
+  }
+  const auto expect_refused = [&](const std::vector<NodeField>& other, const char* why) {
+    try {
+      FrameWriter restarted(h5.string(), block, 25, "scene", 20, 0.0, {}, other);
+      ADD_FAILURE() << "restart accepted " << why;
+    } catch (const std::runtime_error& error) {
+      EXPECT_NE(std::string(error.what()).find(h5.string()), std::string::npos) << error.what();
+    }
+    const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+    EXPECT_EQ(dataset_shape(file.get(), "/fields/curvature")[0], 5u) << why;
+  };
+  expect_refused({}, "without fields");
+  expect_refused({kFields[0]}, "with one field of two");
+  expect_refused({kFields[0], {"curvature", "1/mm", false}}, "with other units");
+  {
+    FrameWriter restarted(h5.string(), block, 25, "scene", 20, 0.0, {}, kFields);
+    EXPECT_EQ(restarted.frames(), 3);
+    times.resize(3);
+    times.push_back(1.5);
+    restarted.write_frame(30, times.back(), frame_field(block, 3), {}, {&velocity, &curvature});
+  }
+  const Hid file(H5Fopen(h5.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
+  EXPECT_EQ(dataset_shape(file.get(), "/fields/velocity"), (std::vector<hsize_t>{4, 3, 2, 3}));
+  EXPECT_EQ(dataset_shape(file.get(), "/fields/curvature"), (std::vector<hsize_t>{4, 3, 2}));
+  EXPECT_EQ(read_text(directory_ / "resume_fields.xmf"),
+            xdmf_document("resume_fields.h5", 3, 2, times, {},
+                          {{"velocity", true}, {"curvature", false}}));
+}
+
 RunSummary example_summary() {
   RunSummary summary;
   summary.scene = "hanging_sheet";

@@ -422,6 +422,55 @@ TEST(Scene, PositiveDefinitenessIsAWarningNotAnError) {
               AllOf(StartsWith(kPath), HasSubstr("component 12"), HasSubstr("positive definite")));
 }
 
+// Every field on a grid of at most kOutputFieldsDefaultMaxNodes nodes, none on a larger one,
+// unless output.fields says which; they are kept in OutputField order whatever the list's.
+TEST(Scene, OutputFieldsDefaultByTheGridsSize) {
+  const std::vector<OutputField> every{OutputField::velocity, OutputField::area_ratio,
+                                       OutputField::curvature, OutputField::energy_density};
+  EXPECT_EQ(parse(SceneText{}).output_fields, every);
+  EXPECT_EQ(all_output_fields(), every);
+  SceneText at_limit;
+  at_limit.grid = "nodes = [500, 500]\nsize = [10.0, 10.0]\n";
+  EXPECT_EQ(parse(at_limit).output_fields, every);
+  SceneText above;
+  above.grid = "nodes = [500, 501]\nsize = [10.0, 10.0]\n";
+  EXPECT_TRUE(parse(above).output_fields.empty());
+  above.tail = "[output]\nfields = [\"energy_density\", \"velocity\"]\n";
+  EXPECT_EQ(parse(above).output_fields,
+            (std::vector<OutputField>{OutputField::velocity, OutputField::energy_density}));
+  SceneText none;
+  none.tail = "[output]\nfields = []\n";
+  EXPECT_TRUE(parse(none).output_fields.empty());
+  // An [output] without fields keeps the default.
+  none.tail = "[output]\n";
+  EXPECT_EQ(parse(none).output_fields, every);
+}
+
+TEST(Scene, OutputFieldNamesAreTheDatasetNames) {
+  std::vector<std::string> names;
+  for (const OutputField field : all_output_fields()) names.emplace_back(output_field_name(field));
+  EXPECT_EQ(names, (std::vector<std::string>{"velocity", "area_ratio", "curvature",
+                                             "energy_density"}));
+}
+
+TEST(SceneError, OutputFields) {
+  SceneText text;
+  text.tail = "[output]\nfields = [\"velocity\", \"speed\"]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(StartsWith(std::string(kPath) + ":"), HasSubstr("key 'output.fields[1]'"),
+                    HasSubstr("unknown field \"speed\"; allowed: velocity, area_ratio, "
+                              "curvature, energy_density")));
+  text.tail = "[output]\nfields = [\"curvature\", \"curvature\"]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'output.fields[1]'"),
+                                    HasSubstr("\"curvature\" is named twice")));
+  text.tail = "[output]\nfields = \"curvature\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'output.fields'"),
+                                    HasSubstr("must be an array of field names")));
+  text.tail = "[output]\nfield = [\"curvature\"]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'output.field'"), HasSubstr("allowed here: fields")));
+}
+
 // ---------------------------------------------------------------------------------------------
 // --set
 
@@ -464,6 +513,15 @@ TEST(SceneSet, GustKeys) {
   ASSERT_TRUE(scene.fluid && scene.fluid->gusts);
   EXPECT_EQ(scene.fluid->gusts->amplitude, 0.5);
   EXPECT_EQ(scene.fluid->gusts->seed, 5u);
+}
+
+TEST(SceneSet, OutputFields) {
+  EXPECT_TRUE(parse(SceneText{}, {"output.fields=[]"}).output_fields.empty());
+  EXPECT_EQ(parse(SceneText{}, {"output.fields=[\"curvature\"]"}).output_fields,
+            std::vector<OutputField>{OutputField::curvature});
+  EXPECT_THAT(error_of(SceneText{}, {"output.fields=[\"strain\"]"}),
+              AllOf(HasSubstr("(from --set): key 'output.fields[0]'"),
+                    HasSubstr("unknown field \"strain\"")));
 }
 
 TEST(SceneSet, WithoutEqualsIsRejected) {

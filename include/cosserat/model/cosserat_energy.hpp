@@ -52,6 +52,10 @@ class CosseratEnergy {
   // Reads the ghosts one node beyond the owned range.
   double block_energy(const Field<Vec3>& positions) const;
 
+  // E_p/(h₁h₂) at every owned node: the stored energy per unit rest area (J/m²) of §2.5.
+  // Reads the ghosts one node beyond the owned range.
+  void energy_density(const Field<Vec3>& positions, Field<double>& density) const;
+
   // E_p of one node and, with `gradient`, ∂E_p/∂r at the nodes of its 3 × 3 box, indexed
   // 3 (dl + 1) + (dk + 1) for the node (k + dk, l + dl). Public for the gradient tests.
   using StencilGradient = std::array<Vec3, 9>;

@@ -97,6 +97,19 @@ struct LinearSolver {
   long max_iterations = 1000;
 };
 
+// The per-node fields a run can write beside its positions (docs/output.md, "Fields"), in the
+// order they are written.
+enum class OutputField { velocity, area_ratio, curvature, energy_density };
+
+// As written in scene files and as the datasets /fields/<name> are named.
+const char* output_field_name(OutputField field);
+std::vector<OutputField> all_output_fields();
+
+// Without output.fields a grid of at most this many nodes writes every field, a larger one
+// none: at 250 000 nodes (500 x 500) a frame's positions take 6 MB and its fields 12 MB more
+// (docs/output.md, "Fields").
+inline constexpr long kOutputFieldsDefaultMaxNodes = 250'000;
+
 struct Scene {
   std::string path;   // the file it came from
   std::string text;   // the scene text as read
@@ -140,6 +153,9 @@ struct Scene {
 
   std::vector<Fix> fixes;
   std::vector<Load> loads;
+  // [output]: the fields written beside the positions, in OutputField order.
+  std::vector<OutputField> output_fields;
+
   // [[solid]]: rigid solids the cloth meets (docs/scene-format.md "Solids"); none: no contact
   // code runs.
   std::vector<SolidSpec> solids;

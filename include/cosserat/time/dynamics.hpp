@@ -55,6 +55,11 @@ class Dynamics {
   // flux form too, whose force is not its gradient: there it shows what the discretisation
   // does to the energy.
   double elastic_energy(const Field<Vec3>& r);
+  // Its density per unit rest area at every owned node (J/m²), for either form alike; reads the
+  // ghosts of r one node beyond the owned range.
+  void energy_density(const Field<Vec3>& r, Field<double>& density) const {
+    energy_.energy_density(r, density);
+  }
   // The mass a node carries (kg): μ0 h1 h2 in the energy form (MODEL.md §2.5), M/(m n) in the
   // flux form's diagnostics.
   double node_mass() const { return node_mass_; }

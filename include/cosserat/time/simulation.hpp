@@ -46,10 +46,11 @@ class Simulation {
   Simulation& operator=(const Simulation&) = delete;
 
   // Upper bound of the memory one rank's block takes: every field of the most demanding
-  // explicit scheme, the force kernel's intermediates and the output buffer, and for the
-  // semi-implicit one its PETSc matrix and colouring.
+  // explicit scheme, the force kernel's intermediates, the output buffer and the
+  // `scalar_output_fields` fields of node_field() the output keeps, and for the semi-implicit
+  // one its PETSc matrix and colouring.
   static double memory_bytes(const Block& block, Integrator integrator,
-                             Discretisation discretisation);
+                             Discretisation discretisation, std::size_t scalar_output_fields = 0);
 
   std::optional<Instability> step() { return stepper_.step(); }
   long step_index() const { return stepper_.step_index(); }
@@ -75,6 +76,12 @@ class Simulation {
   // The stored energy of MODEL.md §2.5 at the current positions (J); a global sum that costs
   // about one force evaluation, so not part of diagnostics().
   double elastic_energy() { return dynamics_.elastic_energy(stepper_.positions()); }
+
+  // A scalar field of the output at the current state into the owned nodes of `values`
+  // (docs/output.md, "Fields"): OutputField::area_ratio, curvature or energy_density; the
+  // velocity field is velocities(). Each node's value is a function of its 3 × 3 box of
+  // positions alone, so every decomposition and thread count gives the same bits.
+  void node_field(OutputField field, Field<double>& values) const;
 
  private:
   static Field<Vec3> rest_positions(const Scene& scene, const Block& block);
