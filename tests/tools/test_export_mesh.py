@@ -30,7 +30,7 @@ nodes = [7, 5]
 size = [1.0, 0.6]
 
 [material]
-preset = "cotton"
+preset = "cotton-10m"
 
 [environment]
 gravity = [0.0, -9.8, 0.0]

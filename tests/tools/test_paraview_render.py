@@ -38,7 +38,7 @@ nodes = [12, 10]
 size = [1.0, 1.0]
 
 [material]
-preset = "cotton"
+preset = "cotton-10m"
 
 [environment]
 gravity = [0.0, -9.8, 0.0]
