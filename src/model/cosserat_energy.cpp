@@ -39,8 +39,7 @@ struct CornerNormals {
   struct Corner {
     int ek, el, fk, fl;  // the offsets of the corner's two edges' far nodes
     Vec3 E, F;           // the edges r_e − r, r_f − r
-    Vec3 unit;           // (E × F)/|E × F|
-    double length;       // |E × F|
+    energy::Corner normal;
   };
   Corner corner[4];
   int count = 0;
@@ -53,17 +52,17 @@ CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbour
   CornerNormals c;
   auto add = [&](int ek, int el, int fk, int fl) {
     CornerNormals::Corner& q = c.corner[c.count++];
-    q = {ek, el, fk, fl, R(k + ek, l + el) - r, R(k + fk, l + fl) - r, {}, 0.0};
-    const Vec3 cross_product = cross(q.E, q.F);
-    q.length = norm(cross_product);
-    q.unit = cross_product / q.length;
+    q.ek = ek, q.el = el, q.fk = fk, q.fl = fl;
+    q.E = R(k + ek, l + el) - r;
+    q.F = R(k + fk, l + fl) - r;
+    q.normal = energy::corner(q.E, q.F);
   };
   if (p.right && p.up) add(1, 0, 0, 1);
   if (p.up && p.left) add(0, 1, -1, 0);
   if (p.left && p.down) add(-1, 0, 0, -1);
   if (p.down && p.right) add(0, -1, 1, 0);
   Vec3 sum;
-  for (int i = 0; i < c.count; ++i) sum += c.corner[i].unit;
+  for (int i = 0; i < c.count; ++i) sum += c.corner[i].normal.unit;
   c.sum_length = norm(sum);
   c.n = sum / c.sum_length;
   return c;
@@ -72,16 +71,12 @@ CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbour
 // Adds the gradient that flows back through n, given G_n = ∂E/∂n.
 void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
                          CosseratEnergy::StencilGradient& g) {
-  // d(s/|s|) projects out n and divides by |s|; the same for each corner's c/|c|.
+  // d(s/|s|) projects out n and divides by |s|; then back through each corner's c/|c|.
   const Vec3 G_s = (G_n - dot(G_n, c.n) * c.n) / c.sum_length;
   for (int i = 0; i < c.count; ++i) {
     const CornerNormals::Corner& q = c.corner[i];
-    const Vec3 G_c = (G_s - dot(G_s, q.unit) * q.unit) / q.length;
-    // c = E × F: G_c · (δE × F) = δE · (F × G_c), G_c · (E × δF) = δF · (G_c × E).
-    const Vec3 G_E = cross(q.F, G_c), G_F = cross(G_c, q.E);
-    g[slot(q.ek, q.el)] += G_E;
-    g[slot(q.fk, q.fl)] += G_F;
-    g[slot(0, 0)] -= G_E + G_F;
+    energy::add_corner_gradient(q.normal, q.E, q.F, G_s, g[slot(q.ek, q.el)],
+                                g[slot(q.fk, q.fl)], g[slot(0, 0)]);
   }
 }
 
