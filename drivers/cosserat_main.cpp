@@ -210,6 +210,14 @@ int set_threads(const cosserat::Decomposition& decomposition, std::optional<int>
                "(--threads or OMP_NUM_THREADS) or fewer ranks\n",
                placement.node_ranks, placement.node_ranks == 1 ? "" : "s", placement.node_cores,
                placement.node_threads);
+  else if (rank == 0 && !placement.requested && placement.idle_cpus > 0)
+    fmt::print(stderr,
+               "note: {} CPU{} of a node {} in no rank's affinity mask (mpirun binds each "
+               "rank to one core by default) and stay{} idle; to use {}, run mpirun with "
+               "--map-by slot:PE=<threads per rank> or --bind-to none (docs/parallel.md)\n",
+               placement.idle_cpus, placement.idle_cpus == 1 ? "" : "s",
+               placement.idle_cpus == 1 ? "is" : "are", placement.idle_cpus == 1 ? "s" : "",
+               placement.idle_cpus == 1 ? "it" : "them");
   return placement.threads;
 }
 

@@ -6,6 +6,10 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <exception>
+#include <fstream>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
@@ -28,6 +32,29 @@ cpu_set_t affinity_mask() {
     for (long cpu = 0; cpu < online; ++cpu) CPU_SET(static_cast<int>(cpu), &mask);
   }
   return mask;
+}
+
+// The CPUs a job may use on this node: those online, within the cgroup's cpuset where one is
+// readable (a container or a batch system's allocation), whatever mpirun bound its ranks to.
+int node_cpus() {
+  const long online = std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, long{CPU_SETSIZE});
+  std::ifstream file("/sys/fs/cgroup/cpuset.cpus.effective");
+  std::string list;
+  if (!std::getline(file, list) || list.empty()) return static_cast<int>(online);
+  // "0-3,8,10-11"
+  long count = 0;
+  std::stringstream ranges(list);
+  for (std::string range; std::getline(ranges, range, ',');) {
+    const auto dash = range.find('-');
+    try {
+      const long first = std::stol(range.substr(0, dash));
+      const long last = dash == std::string::npos ? first : std::stol(range.substr(dash + 1));
+      count += std::max(0L, last - first + 1);
+    } catch (const std::exception&) {
+      return static_cast<int>(online);
+    }
+  }
+  return static_cast<int>(std::clamp(count, 1L, online));
 }
 
 bool explicit_thread_count() {
@@ -66,6 +93,11 @@ ThreadPlacement place_threads(MPI_Comm comm, long rows, std::optional<int> reque
   int node_threads = 0;
   MPI_Allreduce(&placement.threads, &node_threads, 1, MPI_INT, MPI_SUM, node);
   MPI_Comm_free(&node);
+  // CPUs of a node that no rank's mask holds: Open MPI binds each of one or two ranks to a
+  // single core by default, so `mpirun -np 1` on a 2-core machine runs one thread on one core
+  // (docs/parallel.md, "Threads that fit").
+  const int idle = std::max(0, node_cpus() - CPU_COUNT(&all));
+  MPI_Allreduce(&idle, &placement.idle_cpus, 1, MPI_INT, MPI_MAX, comm);
   // Rank 0 reports one node: the one with the most threads per core.
   const int node_cores = CPU_COUNT(&all);
   struct {

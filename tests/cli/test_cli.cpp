@@ -594,6 +594,26 @@ TEST_F(Cli, RanksSharingTheirCoresSplitThem) {
   EXPECT_THAT(r.output, Not(HasSubstr("warning")));
 }
 
+// Open MPI binds one rank to one core by default: on a machine of more cores the rank runs
+// one thread and says how to use the cores left idle (measured at half the speed of two
+// threads: docs/parallel.md, "Threads that fit"). Given a thread count, it says nothing.
+TEST_F(Cli, ARankBoundToOneOfSeveralCoresSaysTheOthersAreIdle) {
+  if (cores_of_this_process() < 2) GTEST_SKIP() << "needs 2 cores";
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const std::string run = "run " + scene + " --set time.steps=10 --overwrite -o " + path("o.h5") +
+                          " --summary " + path("s.json");
+  const Result bound = shell("env -u OMP_NUM_THREADS -u OMPI_MCA_hwloc_base_binding_policy "
+                             "timeout 120 " + on_ranks(1, run));
+  ASSERT_EQ(bound.status, 0) << bound.output;
+  if (summary_threads(path("s.json")) > 1) GTEST_SKIP() << "this MPI did not bind the rank";
+  EXPECT_THAT(bound.output, HasSubstr("stays idle; to use it"));
+  EXPECT_THAT(bound.output, HasSubstr("--map-by slot:PE="));
+  const Result asked = shell("env -u OMP_NUM_THREADS -u OMPI_MCA_hwloc_base_binding_policy "
+                             "timeout 120 " + on_ranks(1, run + " --threads 1"));
+  ASSERT_EQ(asked.status, 0) << asked.output;
+  EXPECT_THAT(asked.output, Not(HasSubstr("idle")));
+}
+
 // An explicit count wins over the default, --threads over OMP_NUM_THREADS, and more threads
 // than cores are run as asked, with a warning.
 TEST_F(Cli, ExplicitThreadCountWinsWithAWarningWhenCoresAreShort) {

@@ -24,6 +24,9 @@ struct ThreadPlacement {
   int node_ranks = 1;
   int node_threads = 1;
   int node_cores = 1;
+  // The most CPUs on any node that none of its ranks' masks holds (online, within the cgroup's
+  // cpuset where readable): a binding that leaves them idle.
+  int idle_cpus = 0;
   bool oversubscribed() const { return node_threads > node_cores; }
 };
 
