@@ -85,7 +85,9 @@ case "${1:-}" in
     build
     ctest --preset release -j "$(nproc)"
     build_debug
-    ctest --preset debug -j "$(nproc)" -L '^(unit|mpi)$'
+    # 4 and 6 ranks run in the release stage; under -O1 they took 85 of CI's 1500 s, and 2, 3
+    # and 2x2 ranks already split the grid both ways, unevenly and across threads.
+    ctest --preset debug -j "$(nproc)" -L '^(unit|mpi)$' -E '^mpi_(4|6)x1$'
     build_asan
     ctest --preset asan -j "$(nproc)" -L '^(unit|cli)$'
     fuzz_scene_loader
