@@ -23,12 +23,14 @@ int default_threads(int cores, int sharing, long rows) {
 
 namespace {
 
+long online_cpus() { return std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, long{CPU_SETSIZE}); }
+
 cpu_set_t affinity_mask() {
   cpu_set_t mask;
   CPU_ZERO(&mask);
   if (sched_getaffinity(0, sizeof(mask), &mask) != 0 || CPU_COUNT(&mask) == 0) {
     // No mask to read: every online CPU, as the OpenMP runtime assumes then.
-    const long online = std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, long{CPU_SETSIZE});
+    const long online = online_cpus();
     for (long cpu = 0; cpu < online; ++cpu) CPU_SET(static_cast<int>(cpu), &mask);
   }
   return mask;
@@ -37,7 +39,7 @@ cpu_set_t affinity_mask() {
 // The CPUs a job may use on this node: those online, within the cgroup's cpuset where one is
 // readable (a container or a batch system's allocation), whatever mpirun bound its ranks to.
 int node_cpus() {
-  const long online = std::clamp(sysconf(_SC_NPROCESSORS_ONLN), 1L, long{CPU_SETSIZE});
+  const long online = online_cpus();
   std::ifstream file("/sys/fs/cgroup/cpuset.cpus.effective");
   std::string list;
   if (!std::getline(file, list) || list.empty()) return static_cast<int>(online);
