@@ -152,10 +152,11 @@ TEST(DecompositionInvariance, FluxFormFollowsTheOneBlockTrajectory) {
   }
 }
 
-// S2 as shipped (a corner held, damping), with one and three threads per rank against the
-// reference's count (OMP_NUM_THREADS).
-TEST(DecompositionInvariance, S2CapeFollowsTheOneBlockTrajectory) {
-  const Scene scene = s2_cape(300);
+// Runs `scene` on every split with one and three threads per rank and hands each run, with
+// the one-block run at the reference's thread count (OMP_NUM_THREADS) and a label, to
+// `expect`.
+template <class Expect>
+void for_every_split_and_thread_count(const Scene& scene, Expect&& expect) {
   Simulation reference(scene, MPI_COMM_SELF, any_scheme);
   ASSERT_TRUE(testing::advance(reference, scene.steps));
   const int default_threads = omp_get_max_threads();
@@ -166,12 +167,21 @@ TEST(DecompositionInvariance, S2CapeFollowsTheOneBlockTrajectory) {
       const bool stable = testing::advance(sim, scene.steps);
       omp_set_num_threads(default_threads);
       ASSERT_TRUE(stable);
-      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
-          << "split " << split_name(d) << ", " << threads << " threads";
-      const Diagnostics a = sim.diagnostics(), b = reference.diagnostics();
-      EXPECT_EQ(a.area_ratio, b.area_ratio);
-      EXPECT_NEAR(a.kinetic_energy, b.kinetic_energy, 1e-12 * b.kinetic_energy);
+      expect(sim, reference,
+             "split " + split_name(d) + ", " + std::to_string(threads) + " threads");
     }
+}
+
+// S2 as shipped (a corner held, damping), with one and three threads per rank against the
+// reference's count.
+TEST(DecompositionInvariance, S2CapeFollowsTheOneBlockTrajectory) {
+  for_every_split_and_thread_count(
+      s2_cape(300), [](Simulation& sim, Simulation& reference, const std::string& run) {
+        EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0) << run;
+        const Diagnostics a = sim.diagnostics(), b = reference.diagnostics();
+        EXPECT_EQ(a.area_ratio, b.area_ratio);
+        EXPECT_NEAR(a.kinetic_energy, b.kinetic_energy, 1e-12 * b.kinetic_energy);
+      });
 }
 
 // The gallery's gusting flag as shipped, its first 0.1 s (1000 steps), with one and three
@@ -180,21 +190,11 @@ TEST(DecompositionInvariance, GustingFlagFollowsTheOneBlockTrajectory) {
   const Scene scene = load_scene(COSSERAT_SOURCE_DIR "/scenes/gallery/flag_gusts.toml",
                                  {"time.duration=0.1"});
   ASSERT_TRUE(scene.fluid && scene.fluid->gusts && scene.fluid->gusts->amplitude > 0.0);
-  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
-  ASSERT_TRUE(testing::advance(reference, scene.steps));
-  const int default_threads = omp_get_max_threads();
-  for (const int threads : {1, 3})
-    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
-      omp_set_num_threads(threads);
-      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
-      const bool stable = testing::advance(sim, scene.steps);
-      omp_set_num_threads(default_threads);
-      ASSERT_TRUE(stable);
-      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
-          << "split " << split_name(d) << ", " << threads << " threads";
-      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
-          << "split " << split_name(d) << ", " << threads << " threads";
-    }
+  for_every_split_and_thread_count(
+      scene, [](Simulation& sim, Simulation& reference, const std::string& run) {
+        EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0) << run;
+        EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0) << run;
+      });
 }
 
 // An observer of nothing: the adaptive step loop's choices alone are compared.
