@@ -295,8 +295,9 @@ void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
 }
 
 template <bool Bending, bool Coupling, bool Normal>
-void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>* normals,
-                          double scale, const Vec3& offset, int qa, int qb, RowScratch& s) const {
+void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double scale,
+                          const Vec3& offset, const RowConsumer& consume, int qa, int qb,
+                          RowScratch& s) const {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   const int k_base = gk0 - 1;  // column 0; the force buffers take p's slots at k − 1
@@ -305,14 +306,14 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>*
   auto force_row = [&](int q) { return s.force.data() + 3 * (q % 3) * w; };
   auto clear = [&](int q) { std::fill_n(force_row(q), 3 * w, 0.0); };
   auto write_out = [&](int q) {
-    const double* f = force_row(q) + (b.k0 - k_base);
-    double* out = &force(b.k0, q).x;  // three packed doubles a node, as load_row reads them
+    double* f = force_row(q) + (b.k0 - k_base);
 #pragma omp simd
     for (int i = 0; i < b.owned_k(); ++i) {
-      out[3 * i] = scale * f[i] + offset.x;
-      out[3 * i + 1] = scale * f[w + i] + offset.y;
-      out[3 * i + 2] = scale * f[2 * w + i] + offset.z;
+      f[i] = scale * f[i] + offset.x;
+      f[w + i] = scale * f[w + i] + offset.y;
+      f[2 * w + i] = scale * f[2 * w + i] + offset.z;
     }
+    consume(q, f, f + w, f + 2 * w);
   };
 
   const int pa = std::max(qa - 1, 0), pb = std::min(qb + 1, b.n);
@@ -392,6 +393,25 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>& force, Field<Vec3>*
 void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
                                     Field<Vec3>* normals, double scale, const Vec3& offset) {
   const Block& b = *block_;
+  all_bands(r, normals, scale, offset, [&](int l, const double* x, const double* y, const double* z) {
+    double* out = &force(b.k0, l).x;  // three packed doubles a node, as load_row reads them
+#pragma omp simd
+    for (int i = 0; i < b.owned_k(); ++i) {
+      out[3 * i] = x[i];
+      out[3 * i + 1] = y[i];
+      out[3 * i + 2] = z[i];
+    }
+  });
+}
+
+void CosseratEnergy::internal_force_rows(const Field<Vec3>& r, double scale, const Vec3& offset,
+                                         const RowConsumer& consume) {
+  all_bands(r, nullptr, scale, offset, consume);
+}
+
+void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, double scale,
+                               const Vec3& offset, const RowConsumer& consume) {
+  const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   // Columns from gk0 − 1 to gk1, and the last interior block's lanes past it.
   const int columns = (gk1 - gk0 + 2) + 2 * kLanes;
@@ -410,18 +430,18 @@ void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
     if (qa < qb) {
       if (normals != nullptr) {
         if (!bending)
-          band<false, false, true>(r, force, normals, scale, offset, qa, qb, s);
+          band<false, false, true>(r, normals, scale, offset, consume, qa, qb, s);
         else if (coupling)
-          band<true, true, true>(r, force, normals, scale, offset, qa, qb, s);
+          band<true, true, true>(r, normals, scale, offset, consume, qa, qb, s);
         else
-          band<true, false, true>(r, force, normals, scale, offset, qa, qb, s);
+          band<true, false, true>(r, normals, scale, offset, consume, qa, qb, s);
       } else {
         if (!bending)
-          band<false, false, false>(r, force, normals, scale, offset, qa, qb, s);
+          band<false, false, false>(r, normals, scale, offset, consume, qa, qb, s);
         else if (coupling)
-          band<true, true, false>(r, force, normals, scale, offset, qa, qb, s);
+          band<true, true, false>(r, normals, scale, offset, consume, qa, qb, s);
         else
-          band<true, false, false>(r, force, normals, scale, offset, qa, qb, s);
+          band<true, false, false>(r, normals, scale, offset, consume, qa, qb, s);
       }
     }
   }

@@ -1,5 +1,6 @@
 #include "cosserat/time/dynamics.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -92,6 +93,37 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
     if (load.window.contains(step, time_))
       a(load.k, load.l) += (inverse_density / h1h2_) * load.force;
   return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
+}
+
+void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
+                                      const CosseratEnergy::RowConsumer& consume) {
+  assert(fuses_rows());
+  const Block& b = *block_;
+  // The loads acting now, in row order; a node's own loads keep their order (stable), so their
+  // sum is free_acceleration's.
+  struct RowLoad {
+    int k, l;
+    Vec3 acceleration;
+  };
+  std::vector<RowLoad> active;
+  const double inverse_density = rest_area_ / mass_;
+  for (const PointLoad& load : loads_)
+    if (load.window.contains(step, time_))
+      active.push_back({load.k, load.l, (inverse_density / h1h2_) * load.force});
+  std::stable_sort(active.begin(), active.end(),
+                   [](const RowLoad& a, const RowLoad& b) { return a.l < b.l; });
+  energy_.internal_force_rows(r, 1.0 / node_mass_, gravity_,
+                              [&](int l, double* x, double* y, double* z) {
+    auto load = std::lower_bound(active.begin(), active.end(), l,
+                                 [](const RowLoad& a, int row) { return a.l < row; });
+    for (; load != active.end() && load->l == l; ++load) {
+      const auto i = static_cast<std::size_t>(load->k - b.k0);
+      x[i] += load->acceleration.x;
+      y[i] += load->acceleration.y;
+      z[i] += load->acceleration.z;
+    }
+    consume(l, x, y, z);
+  });
 }
 
 double Dynamics::elastic_energy(const Field<Vec3>& r) {

@@ -51,13 +51,32 @@ std::optional<std::string> VerletFamily::propose(long step) {
 // central-difference Verlet, bit for bit: (Δt + Δt)/2 is Δt exactly.
 void VerletFamily::centred_step(long step) {
   context_.constraints.hold_positions(previous_positions_);  // a node held from now on starts at rest
-  Field<Vec3>* n_field = normals();
-  const VelocityTerms terms =
-      context_.dynamics.free_acceleration(positions_, step, acceleration_, n_field);
+  Dynamics& dynamics = context_.dynamics;
   const double dt = context_.dt;
   const double weight = dt * ((dt + dt_previous_) * 0.5);
   const double ratio = dt / dt_previous_;
   const double span = dt + dt_previous_;
+  // Without damping c is 0 and the update is r⁺ = r + ratio (r − r⁻) + weight a, exactly.
+  auto update = [&](const Vec3& r, const Vec3& rp, const Vec3& a, double c) {
+    return (r + ratio * (r - rp) + weight * a + c * rp) / (1.0 + c);
+  };
+  if (dynamics.fuses_rows()) {
+    // Each row of a is used while the kernel still has it in cache, and never stored: the
+    // step's largest sweep of memory saved (docs/kernel.md).
+    const double c = dynamics.row_velocity_terms().damping * weight / span;
+    const Block& b = context_.block;
+    dynamics.free_acceleration_rows(positions_, step, [&](int l, double* x, double* y, double* z) {
+      const Vec3* r = &positions_(b.k0, l);
+      const Vec3* rp = &previous_positions_(b.k0, l);
+      Vec3* next = &next_positions_(b.k0, l);
+#pragma omp simd
+      for (int i = 0; i < b.owned_k(); ++i) next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
+    });
+    context_.constraints.hold_positions(next_positions_);
+    return;
+  }
+  Field<Vec3>* n_field = normals();
+  const VelocityTerms terms = dynamics.free_acceleration(positions_, step, acceleration_, n_field);
   const double c = terms.damping * weight / span;
   const double d = terms.fluid * weight / span;
   // Two loops rather than a test per node, so that each vectorises.
@@ -71,8 +90,7 @@ void VerletFamily::centred_step(long step) {
     });
   } else {
     for_owned(context_.block, [&](int k, int l) {
-      const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
-      next_positions_(k, l) = (r + ratio * (r - rp) + weight * acceleration_(k, l) + c * rp) / (1.0 + c);
+      next_positions_(k, l) = update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
     });
   }
   context_.constraints.hold_positions(next_positions_);

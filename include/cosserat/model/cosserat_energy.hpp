@@ -3,6 +3,7 @@
 // §2.1, summed over the nodes, and the internal force as its exact negative gradient.
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
@@ -48,6 +49,14 @@ class CosseratEnergy {
                       Field<Vec3>* normals = nullptr, double scale = 1.0,
                       const Vec3& offset = {});
 
+  // A finished row l of scale · f + offset, as three component arrays over the owned columns
+  // (column b.k0 first), handed over while it is still in cache instead of written to a field;
+  // the consumer may change them. Called from the thread that owns the row, once per owned row,
+  // in ascending order within a thread.
+  using RowConsumer = std::function<void(int l, double* x, double* y, double* z)>;
+  void internal_force_rows(const Field<Vec3>& positions, double scale, const Vec3& offset,
+                           const RowConsumer& consume);
+
   // This block's share of E (J): the energies of the nodes it owns, summed row by row in order.
   // Reads the ghosts one node beyond the owned range.
   double block_energy(const Field<Vec3>& positions) const;
@@ -77,8 +86,10 @@ class CosseratEnergy {
   void interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const;
   void border_node(const Field<Vec3>& positions, int k, int l, int k_base, RowScratch& s) const;
   template <bool Bending, bool Coupling, bool Normal>
-  void band(const Field<Vec3>& positions, Field<Vec3>& force, Field<Vec3>* normals,
-            double scale, const Vec3& offset, int qa, int qb, RowScratch& s) const;
+  void band(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
+            const Vec3& offset, const RowConsumer& consume, int qa, int qb, RowScratch& s) const;
+  void all_bands(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
+                 const Vec3& offset, const RowConsumer& consume);
 
   const Block* block_;
   double h1_, h2_;

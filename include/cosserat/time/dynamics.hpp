@@ -30,6 +30,19 @@ class Dynamics {
   VelocityTerms free_acceleration(const Field<Vec3>& r, long step, Field<Vec3>& a,
                                   Field<Vec3>* normals);
 
+  // Whether free_acceleration_rows can stand for free_acceleration: the energy form without a
+  // fluid, whose terms need every row's normals before any row's acceleration is complete.
+  bool fuses_rows() const {
+    return discretisation_ == Discretisation::energy && !fluid_.has_value();
+  }
+  // The velocity terms free_acceleration would return; with fuses_rows() only.
+  VelocityTerms row_velocity_terms() const { return VelocityTerms{damping_ * (rest_area_ / mass_), 0.0}; }
+  // free_acceleration's `a`, without the field: each finished row goes to `consume` (see
+  // CosseratEnergy::internal_force_rows) while it is in cache, so that a scheme's update reads
+  // it there. The same bits as free_acceleration's; with fuses_rows() only.
+  void free_acceleration_rows(const Field<Vec3>& r, long step,
+                              const CosseratEnergy::RowConsumer& consume);
+
   // The internal force's share of the acceleration, f_int/μ, into `a`: independent of S
   // (MODEL.md §3), so a function of the positions alone. The semi-implicit baseline
   // differentiates it.
