@@ -3,11 +3,13 @@
 # 1024² and 4096² on 1 and 2 threads, and of each combination of model terms (verlet_step_terms,
 # 1024², 1 thread), for this build and for BEFORE, a bench_step binary built from the older
 # revision with the same preset. The two binaries run alternately, each case twice, so drift of
-# the machine shows in both. Results into benchmarks/results/kernel-<host>-<date>.{json,md}.
+# the machine shows in both. Results into benchmarks/results/NAME-<host>-<date>.{json,md}, NAME
+# "kernel" unless RESULT_NAME says otherwise (so that a later comparison keeps an earlier one).
 #   BEFORE=/path/to/old/bench_step BEFORE_REVISION=abc1234 benchmarks/run_kernel.sh
+#   RESULT_NAME=kernel-fused BEFORE=... benchmarks/run_kernel.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source benchmarks/context.sh kernel benchmark bench_step
+source benchmarks/context.sh "${RESULT_NAME:-kernel}" benchmark bench_step
 : "${BEFORE:?set BEFORE to the bench_step of the revision to compare with}"
 : "${BEFORE_REVISION:=unknown}"
 
