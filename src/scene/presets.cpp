@@ -1,6 +1,6 @@
-// Material presets (docs/materials.md): fabrics at their real size from KES-F numbers (one
-// published measurement, five typical values), and the published 10 m calibrations under names
-// of their own.
+// Material presets (docs/materials.md): fabrics at their real size from KES-F numbers (denim's
+// measured; cotton's, wool's and polyester's bending rigidity and weight measured, the rest
+// typical values), and the published 10 m calibrations under names of their own.
 
 #include <algorithm>
 #include <cmath>
@@ -60,16 +60,18 @@ double coupling_fraction(double zeta, double xi, double phi) {
 }  // namespace
 
 const std::vector<Preset>& material_presets() {
-  // Sources and the reasons for each number: docs/materials.md. Only denim's KES-F numbers were
-  // read from a published table; silk, cotton, linen, wool and polyester are typical values,
-  // unverified, kept until a measured specimen of each replaces them. Wool and polyester have no
-  // calibration; their coupling is 0.03, inside the calibrations' 0.0025 (linen) to 0.05 (silk).
+  // Sources and the reasons for each number: docs/materials.md. Denim's KES-F numbers come from
+  // one published table; cotton's, wool's and polyester's B and weight from another (Matsudaira
+  // et al. 2015, fabrics A, B and C), their G and EMT are typical values; silk and linen are
+  // typical values throughout, unverified, kept until a measured specimen replaces them. Wool
+  // and polyester have no calibration; their coupling is 0.03, inside the calibrations' 0.0025
+  // (linen) to 0.05 (silk).
   static const std::vector<Preset> presets{
       measured_fabric({"silk", 60.0, 0.03, 0.4, 8.0, coupling_fraction(100.0, 0.01, 0.1)}),
-      measured_fabric({"cotton", 120.0, 0.10, 1.0, 4.0, coupling_fraction(100.0, 0.02, 0.1)}),
+      measured_fabric({"cotton", 123.8, 0.118, 1.0, 4.0, coupling_fraction(100.0, 0.02, 0.1)}),
       measured_fabric({"linen", 180.0, 0.30, 1.5, 3.0, coupling_fraction(100.0, 0.04, 0.01)}),
-      measured_fabric({"wool", 250.0, 0.10, 0.6, 5.0, 0.03}),
-      measured_fabric({"polyester", 110.0, 0.06, 0.8, 3.0, 0.03}),
+      measured_fabric({"wool", 162.9, 0.067, 0.6, 5.0, 0.03}),
+      measured_fabric({"polyester", 116.5, 0.077, 0.8, 3.0, 0.03}),
       measured_fabric({"denim", 324.0, 0.172, 2.18, 5.515, coupling_fraction(100.0, 0.03, 0.1)}),
       calibration("silk-10m", 78.0, 100.0, 0.01, 0.1),
       calibration("cotton-10m", 88.0, 100.0, 0.02, 0.1),

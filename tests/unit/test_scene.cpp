@@ -237,14 +237,14 @@ TEST(Scene, PresetGivesEverythingAndScalesMassToTheSheet) {
 TEST(Scene, RealSizePresetKeepsItsArealDensityAtAnySize) {
   const Preset cotton = *find_preset("cotton");
   EXPECT_EQ(cotton.area, 1.0);
-  EXPECT_DOUBLE_EQ(cotton.mass, 0.120);  // 120 g/m², docs/materials.md
+  EXPECT_DOUBLE_EQ(cotton.mass, 0.1238);  // 123.8 g/m², docs/materials.md
   for (const char* size : {"[1.0, 1.0]", "[0.4, 2.5]", "[10.0, 10.0]"}) {
     SceneText text;
     text.grid = std::string("nodes = [5, 5]\nsize = ") + size + "\n";
     text.material = "preset = \"cotton\"\n";
     const Scene scene = parse(text);
     SCOPED_TRACE(size);
-    EXPECT_DOUBLE_EQ(scene.material.mass / (scene.size1 * scene.size2), 0.120);
+    EXPECT_DOUBLE_EQ(scene.material.mass / (scene.size1 * scene.size2), 0.1238);
     EXPECT_EQ(scene.material.zeta, cotton.zeta);
     EXPECT_EQ(scene.material.xi, cotton.xi);
     EXPECT_EQ(scene.material.phi, cotton.phi);
@@ -255,8 +255,8 @@ TEST(Scene, RealSizePresetKeepsItsArealDensityAtAnySize) {
 // ζ₁₁ = ζ₂₂ = K/6 with K = 500 gf/cm over EMT, each in SI; φ inside its bound.
 TEST(Scene, MeasuredPresetsFollowTheirKesNumbers) {
   constexpr double gf = 9.80665e-3;  // N
-  const Preset cotton = *find_preset("cotton");  // B 0.10 gf cm²/cm, G 1.0 gf/(cm deg), EMT 4 %
-  EXPECT_NEAR(cotton.xi[0], 0.10 * gf * 1e-2 / 6.0, 1e-18);
+  const Preset cotton = *find_preset("cotton");  // B 0.118 gf cm²/cm, G 1.0 gf/(cm deg), EMT 4 %
+  EXPECT_NEAR(cotton.xi[0], 0.118 * gf * 1e-2 / 6.0, 1e-18);
   EXPECT_EQ(cotton.xi[0], cotton.xi[1]);
   EXPECT_EQ(cotton.xi[0], cotton.xi[2]);
   EXPECT_NEAR(cotton.zeta[1], 1.0 * gf / 1e-2 * 180.0 / std::numbers::pi, 1e-12);
