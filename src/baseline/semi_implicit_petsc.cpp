@@ -231,8 +231,8 @@ void SemiImplicitSolver::linearise(const Field<Vec3>& r) {
 
 std::optional<std::string> SemiImplicitSolver::solve(
     const VelocityTerms& terms, const Field<Vec3>* normals, const Field<Vec3>& rhs,
-    const Field<Vec3>& guess,
-    const std::vector<Constraints::NodeState>& held, Field<Vec3>& delta) {
+    const Field<Vec3>& guess, const std::vector<Constraints::NodeState>& held,
+    const Field<Vec3>& positions, double end_time, Field<Vec3>& delta) {
   Impl& s = *impl_;
   const Block& bl = *s.block;
   const auto start = std::chrono::steady_clock::now();
@@ -260,26 +260,27 @@ std::optional<std::string> SemiImplicitSolver::solve(
     check(MatAssemblyEnd(s.matrix, MAT_FINAL_ASSEMBLY));
   }
 
-  // Held components: δ = 0, rows and columns replaced by the diagonal (symmetry
-  // kept for cg).
+  // Held components: δ is the held value at the step's end less rⁿ (0 for a still fix), rows
+  // and columns replaced by the diagonal (symmetry kept for cg), the other rows' right-hand
+  // side moved by the columns' share of that δ.
   std::vector<PetscInt> held_rows;
+  s.copy_in(rhs, s.b);
+  s.copy_in(guess, s.delta);
   for (const Constraints::NodeState& node : held)
     if (bl.owns(node.k, node.l))
       for (int c = 0; c < 3; ++c)
-        if (node.held & (1u << c)) held_rows.push_back(s.first_row + s.offset(node.k, node.l, c));
-  check(MatZeroRowsColumns(s.matrix, static_cast<PetscInt>(held_rows.size()), held_rows.data(),
-                           diagonal, nullptr, nullptr));
-
-  s.copy_in(rhs, s.b);
-  s.copy_in(guess, s.delta);
-  for (const PetscInt row : held_rows) {
-    check(VecSetValue(s.b, row, 0.0, INSERT_VALUES));
-    check(VecSetValue(s.delta, row, 0.0, INSERT_VALUES));
-  }
+        if (node.held & (1u << c)) {
+          const PetscInt row = s.first_row + s.offset(node.k, node.l, c);
+          held_rows.push_back(row);
+          const double held_delta = node.position(c, end_time) - positions(node.k, node.l)[c];
+          check(VecSetValue(s.delta, row, held_delta, INSERT_VALUES));
+        }
   check(VecAssemblyBegin(s.b));
   check(VecAssemblyEnd(s.b));
   check(VecAssemblyBegin(s.delta));
   check(VecAssemblyEnd(s.delta));
+  check(MatZeroRowsColumns(s.matrix, static_cast<PetscInt>(held_rows.size()), held_rows.data(),
+                           diagonal, s.delta, s.b));
 
   check(KSPSolve(s.ksp, s.b, s.delta));
   KSPConvergedReason reason;

@@ -34,7 +34,7 @@ class SemiImplicitScheme final : public VerletFamily {
 // With J = 0 it is the centred Verlet step's closed form.
 std::optional<std::string> SemiImplicitScheme::propose(long step) {
   Constraints& constraints = context_.constraints;
-  constraints.hold_positions(previous_positions_);
+  constraints.hold_positions(previous_positions_, previous_time(dt_previous_));
   solver_.linearise(positions_);
   Field<Vec3>* n_field = normals();
   const VelocityTerms terms =
@@ -53,11 +53,12 @@ std::optional<std::string> SemiImplicitScheme::propose(long step) {
     right_hand_side_(k, l) = b;
   });
   if (auto failure = solver_.solve(terms, n_field, right_hand_side_, history_,
-                                   constraints.state(), increment_))
+                                   constraints.state(), positions_, context_.end_time,
+                                   increment_))
     return failure;
   for_owned(context_.block,
             [&](int k, int l) { next_positions_(k, l) = positions_(k, l) + increment_(k, l); });
-  constraints.hold_positions(next_positions_);
+  constraints.hold_positions(next_positions_, context_.end_time);
   return std::nullopt;
 }
 

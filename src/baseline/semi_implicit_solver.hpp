@@ -33,12 +33,13 @@ class SemiImplicitSolver {
 
   // Solves the system for δ with the J of the last linearise(), velocity terms
   // `terms` (and the normals at rⁿ when there is a fluid), right-hand side `rhs`, starting
-  // from `guess`. The components `held` lists get δ = 0. Returns why the solve
-  // failed, or nothing.
+  // from `guess`. The components `held` lists get the δ that takes them from `positions` (rⁿ)
+  // to their held value at `end_time`. Returns why the solve failed, or nothing.
   std::optional<std::string> solve(const VelocityTerms& terms, const Field<Vec3>* normals,
                                    const Field<Vec3>& rhs,
                                    const Field<Vec3>& guess,
                                    const std::vector<Constraints::NodeState>& held,
+                                   const Field<Vec3>& positions, double end_time,
                                    Field<Vec3>& delta);
 
   const LinearSolveStats& stats() const;

@@ -82,33 +82,55 @@ void write_constraints(const hdf5::File& file, const Constraints& constraints, M
 
   std::vector<std::int32_t> nodes;
   std::vector<std::uint8_t> held;
-  std::vector<double> values;
+  std::vector<double> values, since, velocities;
   for (const Constraints::NodeState& s : local) {
     nodes.insert(nodes.end(), {s.k, s.l});
     held.push_back(s.held);
     values.insert(values.end(), {s.value.x, s.value.y, s.value.z});
+    since.insert(since.end(), {s.since.x, s.since.y, s.since.z});
+    velocities.insert(velocities.end(), {s.velocity.x, s.velocity.y, s.velocity.z});
   }
   const auto rows = static_cast<hsize_t>(count), at = static_cast<hsize_t>(offset);
   const auto all = static_cast<hsize_t>(total);
   const Handle node_set = create_dataset(file, "/constraint_nodes", H5T_STD_I32LE, {all, 2});
   const Handle held_set = create_dataset(file, "/constraint_held", H5T_STD_U8LE, {all, 1});
   const Handle value_set = create_dataset(file, "/constraint_values", H5T_IEEE_F64LE, {all, 3});
+  const Handle since_set = create_dataset(file, "/constraint_since", H5T_IEEE_F64LE, {all, 3});
+  const Handle velocity_set =
+      create_dataset(file, "/constraint_velocities", H5T_IEEE_F64LE, {all, 3});
   if (all == 0) return;
   write_rows(file, node_set, H5T_NATIVE_INT32, at, rows, 2, nodes.data(), "write constraints");
   write_rows(file, held_set, H5T_NATIVE_UINT8, at, rows, 1, held.data(), "write constraints");
   write_rows(file, value_set, H5T_NATIVE_DOUBLE, at, rows, 3, values.data(), "write constraints");
+  write_rows(file, since_set, H5T_NATIVE_DOUBLE, at, rows, 3, since.data(), "write constraints");
+  write_rows(file, velocity_set, H5T_NATIVE_DOUBLE, at, rows, 3, velocities.data(),
+             "write constraints");
 }
 
 std::vector<Constraints::NodeState> read_constraints(const hdf5::File& file) {
   const auto nodes = read_all<std::int32_t>(file, "/constraint_nodes", H5T_NATIVE_INT32, 2);
   const auto held = read_all<std::uint8_t>(file, "/constraint_held", H5T_NATIVE_UINT8, 1);
   const auto values = read_all<double>(file, "/constraint_values", H5T_NATIVE_DOUBLE, 3);
-  if (nodes.size() != 2 * held.size() || values.size() != 3 * held.size())
+  // Checkpoints written before fixes had velocities lack these: every fix was still, so each
+  // held component moves at 0 (and when it was taken does not matter).
+  const auto optional = [&](const char* name) {
+    const bool present = file.check(H5Lexists(file.get(), name, H5P_DEFAULT), "look for " +
+                                    std::string(name)) > 0;
+    return present ? read_all<double>(file, name, H5T_NATIVE_DOUBLE, 3)
+                   : std::vector<double>(3 * held.size(), 0.0);
+  };
+  const auto since = optional("/constraint_since");
+  const auto velocities = optional("/constraint_velocities");
+  if (nodes.size() != 2 * held.size() || values.size() != 3 * held.size() ||
+      since.size() != 3 * held.size() || velocities.size() != 3 * held.size())
     file.fail("read constraints (lengths differ)");
+  const auto vec3 = [](const std::vector<double>& v, std::size_t i) {
+    return Vec3{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+  };
   std::vector<Constraints::NodeState> states;
   for (std::size_t i = 0; i < held.size(); ++i)
-    states.push_back({nodes[2 * i], nodes[2 * i + 1], held[i],
-                      Vec3{values[3 * i], values[3 * i + 1], values[3 * i + 2]}});
+    states.push_back({nodes[2 * i], nodes[2 * i + 1], held[i], vec3(values, i), vec3(since, i),
+                      vec3(velocities, i)});
   return states;
 }
 
@@ -212,9 +234,11 @@ std::optional<std::string> check_constraints(const std::vector<Constraints::Node
       return fmt::format("{} holds components {:#05b}, beyond the {:#05b} this scene's fixes "
                          "hold",
                          node, s.held, fixed->second);
-    if (!(std::isfinite(s.value.x) && std::isfinite(s.value.y) && std::isfinite(s.value.z)))
-      return fmt::format("{} is held at ({}, {}, {}), not finite", node, s.value.x, s.value.y,
-                         s.value.z);
+    if (!(is_finite(s.value) && is_finite(s.since) && is_finite(s.velocity)))
+      return fmt::format("{} is held at ({}, {}, {}), from t = ({}, {}, {}) s, at ({}, {}, {}) "
+                         "m/s: not finite",
+                         node, s.value.x, s.value.y, s.value.z, s.since.x, s.since.y, s.since.z,
+                         s.velocity.x, s.velocity.y, s.velocity.z);
   }
   for (const auto& [kl, axes] : axes_of)
     if (!seen.contains(kl))

@@ -666,11 +666,22 @@ std::array<bool, 3> held_axes(const Entry& entry) {
 }
 
 Fix read_fix(const Table& block, const Scene& scene) {
-  block.allow({"nodes", "region", "axes", "start", "end", "start_time", "end_time"});
+  block.allow(
+      {"nodes", "region", "axes", "start", "end", "start_time", "end_time", "velocity"});
   Fix fix;
   fix.nodes = read_node_set(block, scene);
   if (const auto axes = block.find("axes")) fix.axes = held_axes(*axes);
   fix.window = read_window(block, scene);
+  if (const auto velocity = block.find("velocity")) {
+    fix.velocity = velocity->vector3();
+    // A velocity along a free axis would be silently ignored: most likely a mistyped axes.
+    for (std::size_t c = 0; c < 3; ++c)
+      if (!fix.axes[c] && fix.velocity[static_cast<int>(c)] != 0.0) {
+        velocity->fail(fmt::format("moves along {}, which this fix does not hold (axes); give 0 "
+                                   "there or hold {} too",
+                                   static_cast<char>('x' + c), static_cast<char>('x' + c)));
+      }
+  }
   return fix;
 }
 

@@ -13,45 +13,62 @@ Constraints::Constraints(const std::vector<Fix>& fixes, const Block& block) {
       if (fix.axes[static_cast<std::size_t>(c)]) axes |= static_cast<std::uint8_t>(1u << c);
     for (const NodeIndex& node : fix.nodes.nodes)
       if (block.owns(node.k, node.l))
-        by_node[{node.l, node.k}].push_back(AxesWindow{axes, fix.window});
+        by_node[{node.l, node.k}].push_back(AxesWindow{axes, fix.window, fix.velocity});
   }
   for (auto& [lk, windows] : by_node)
-    nodes_.push_back(HeldNode{lk.second, lk.first, std::move(windows), 0, {}});
+    nodes_.push_back(HeldNode{std::move(windows), NodeState{lk.second, lk.first, 0, {}}});
 }
 
 void Constraints::begin_step(long step, double time, const Field<Vec3>& positions) {
   for (HeldNode& node : nodes_) {
+    NodeState& s = node.state;
     std::uint8_t held = 0;
+    Vec3 velocity{};
+    // Of the fixes holding a component in this step, the last in the scene sets its velocity:
+    // a fix that takes over from another at the end of its window then needs no gap.
     for (const AxesWindow& w : node.windows)
-      if (w.window.contains(step, time)) held |= w.axes;
-    const std::uint8_t newly_held = held & static_cast<std::uint8_t>(~node.held);
-    const Vec3 now = positions(node.k, node.l);
-    for (int c = 0; c < 3; ++c)
-      if (newly_held & (1u << c)) node.value[c] = now[c];
-    node.held = held;
+      if (w.window.contains(step, time)) {
+        held |= w.axes;
+        for (int c = 0; c < 3; ++c)
+          if (w.axes & (1u << c)) velocity[c] = w.velocity[c];
+      }
+    const Vec3 now = positions(s.k, s.l);
+    for (int c = 0; c < 3; ++c) {
+      const bool newly_held = (held & ~s.held) & (1u << c);
+      const bool held_on = (held & s.held) & (1u << c);
+      // The held value is where the node is, so a change of velocity does not make it jump.
+      if (newly_held || (held_on && velocity[c] != s.velocity[c])) {
+        s.value[c] = now[c];
+        s.since[c] = time;
+      }
+      s.velocity[c] = (held & (1u << c)) ? velocity[c] : 0.0;
+    }
+    s.held = held;
   }
 }
 
-void Constraints::hold_positions(Field<Vec3>& positions) const {
+void Constraints::hold_positions(Field<Vec3>& positions, double time) const {
   for (const HeldNode& node : nodes_) {
-    Vec3& r = positions(node.k, node.l);
+    const NodeState& s = node.state;
+    Vec3& r = positions(s.k, s.l);
     for (int c = 0; c < 3; ++c)
-      if (node.held & (1u << c)) r[c] = node.value[c];
+      if (s.held & (1u << c)) r[c] = s.position(c, time);
   }
 }
 
 void Constraints::hold_velocities(Field<Vec3>& velocities) const {
   for (const HeldNode& node : nodes_) {
-    Vec3& v = velocities(node.k, node.l);
+    const NodeState& s = node.state;
+    Vec3& v = velocities(s.k, s.l);
     for (int c = 0; c < 3; ++c)
-      if (node.held & (1u << c)) v[c] = 0.0;
+      if (s.held & (1u << c)) v[c] = s.velocity[c];
   }
 }
 
 std::vector<Constraints::NodeState> Constraints::state() const {
   std::vector<NodeState> states;
   states.reserve(nodes_.size());
-  for (const HeldNode& node : nodes_) states.push_back({node.k, node.l, node.held, node.value});
+  for (const HeldNode& node : nodes_) states.push_back(node.state);
   return states;
 }
 
@@ -59,10 +76,8 @@ void Constraints::restore(const std::vector<NodeState>& states) {
   std::map<std::pair<int, int>, const NodeState*> by_node;
   for (const NodeState& s : states) by_node[{s.k, s.l}] = &s;
   for (HeldNode& node : nodes_)
-    if (const auto found = by_node.find({node.k, node.l}); found != by_node.end()) {
-      node.held = found->second->held;
-      node.value = found->second->value;
-    }
+    if (const auto found = by_node.find({node.state.k, node.state.l}); found != by_node.end())
+      node.state = *found->second;
 }
 
 }  // namespace cosserat

@@ -14,14 +14,14 @@ Scheme::Scheme(const StepContext& context, const Field<Vec3>& positions)
   if (context.dynamics.has_fluid()) normals_ = Field<Vec3>(context.block);
 }
 
-void Scheme::hold(Field<Vec3>& r, Field<Vec3>& v) const {
-  context_.constraints.hold_positions(r);
+void Scheme::hold(Field<Vec3>& r, Field<Vec3>& v, double fraction) const {
+  context_.constraints.hold_positions(r, stage_time(fraction));
   context_.constraints.hold_velocities(v);
 }
 
 void Scheme::begin(Field<Vec3> velocities) {
   context_.constraints.begin_step(0, 0.0, positions_);
-  hold(positions_, velocities);
+  hold(positions_, velocities, 0.0);
   context_.halo.exchange(positions_);
   start(std::move(velocities));
 }

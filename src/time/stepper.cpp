@@ -41,7 +41,7 @@ std::optional<Instability> Stepper::step() {
 }
 
 std::optional<Instability> Stepper::step(double dt, double end_time) {
-  scheme_->set_step(dt, time_);
+  scheme_->set_step(dt, time_, end_time);
   dynamics_->set_time(time_);
   constraints_.begin_step(step_, time_, scheme_->positions());
   if (auto solver_failure = scheme_->advance(step_)) {

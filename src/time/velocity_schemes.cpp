@@ -46,7 +46,7 @@ std::optional<std::string> Leapfrog::advance(long step) {
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) = positions_(k, l) + dt * next_velocity_(k, l);
   });
-  context_.constraints.hold_positions(next_positions_);
+  context_.constraints.hold_positions(next_positions_, context_.end_time);
   return std::nullopt;
 }
 
@@ -61,7 +61,7 @@ std::optional<std::string> Euler::advance(long step) {
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) = positions_(k, l) + dt * drift(k, l);
   });
-  context_.constraints.hold_positions(next_positions_);
+  context_.constraints.hold_positions(next_positions_, context_.end_time);
   return std::nullopt;
 }
 
@@ -79,7 +79,7 @@ std::optional<std::string> Midpoint::advance(long step) {
     midpoint_positions_(k, l) = positions_(k, l) + (0.5 * dt) * velocity_(k, l);
     midpoint_velocity_(k, l) = velocity_(k, l) + (0.5 * dt) * acceleration_(k, l);
   });
-  hold(midpoint_positions_, midpoint_velocity_);
+  hold(midpoint_positions_, midpoint_velocity_, 0.5);
   context_.halo.exchange(midpoint_positions_);
   dynamics.set_stage_time(context_.time + 0.5 * dt);
   dynamics.acceleration(midpoint_positions_, midpoint_velocity_, step, acceleration_, normals());
@@ -87,7 +87,7 @@ std::optional<std::string> Midpoint::advance(long step) {
     next_positions_(k, l) = positions_(k, l) + dt * midpoint_velocity_(k, l);
     next_velocity_(k, l) = velocity_(k, l) + dt * acceleration_(k, l);
   });
-  hold(next_positions_, next_velocity_);
+  hold(next_positions_, next_velocity_, 1.0);
   return std::nullopt;
 }
 
@@ -110,7 +110,7 @@ std::optional<std::string> RungeKutta4::advance(long step) {
     stage_positions_(k, l) = positions_(k, l) + (0.5 * dt) * velocity_(k, l);
     stage_velocity_(k, l) = velocity_(k, l) + (0.5 * dt) * acceleration_(k, l);
   });
-  hold(stage_positions_, stage_velocity_);
+  hold(stage_positions_, stage_velocity_, 0.5);
   // Stages 2 and 3 belong to the step's middle, stage 4 to its end.
   dynamics.set_stage_time(context_.time + 0.5 * dt);
   for (const double fraction : {0.5, 1.0}) {
@@ -123,7 +123,7 @@ std::optional<std::string> RungeKutta4::advance(long step) {
       stage_positions_(k, l) = positions_(k, l) + (fraction * dt) * vs;
       stage_velocity_(k, l) = velocity_(k, l) + (fraction * dt) * as;
     });
-    hold(stage_positions_, stage_velocity_);
+    hold(stage_positions_, stage_velocity_, fraction);
   }
   halo.exchange(stage_positions_);
   dynamics.set_stage_time(context_.time + dt);
@@ -134,7 +134,7 @@ std::optional<std::string> RungeKutta4::advance(long step) {
     next_velocity_(k, l) =
         velocity_(k, l) + (dt / 6.0) * (acceleration_sum_(k, l) + acceleration_(k, l));
   });
-  hold(next_positions_, next_velocity_);
+  hold(next_positions_, next_velocity_, 1.0);
   return std::nullopt;
 }
 
@@ -152,7 +152,7 @@ std::optional<std::string> VelocityVerlet::advance(long step) {
         positions_(k, l) + dt * velocity_(k, l) + (0.5 * dt * dt) * acceleration_(k, l);
     predicted_velocity_(k, l) = velocity_(k, l) + dt * acceleration_(k, l);
   });
-  hold(next_positions_, predicted_velocity_);
+  hold(next_positions_, predicted_velocity_, 1.0);
   context_.halo.exchange(next_positions_);
   // a⁺ belongs to the end of the step, where load windows in seconds are told.
   context_.dynamics.set_time(context_.time + dt);

@@ -28,7 +28,7 @@ void VerletFamily::start(Field<Vec3> velocities) {
           positions_(k, l) - dt * velocities(k, l) + (0.5 * dt * dt) * acceleration_(k, l);
     });
   }
-  context_.constraints.hold_positions(previous_positions_);
+  context_.constraints.hold_positions(previous_positions_, previous_time(dt));
 }
 
 std::optional<std::string> VerletFamily::advance(long step) {
@@ -50,7 +50,8 @@ std::optional<std::string> VerletFamily::propose(long step) {
 // v = (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁), solved in closed form. With a constant step both are the plain
 // central-difference Verlet, bit for bit: (Δt + Δt)/2 is Δt exactly.
 void VerletFamily::centred_step(long step) {
-  context_.constraints.hold_positions(previous_positions_);  // a node held from now on starts at rest
+  // A node held from now on starts at its held velocity (at rest, for a still fix).
+  context_.constraints.hold_positions(previous_positions_, previous_time(dt_previous_));
   Dynamics& dynamics = context_.dynamics;
   const double dt = context_.dt;
   const double weight = dt * ((dt + dt_previous_) * 0.5);
@@ -72,7 +73,7 @@ void VerletFamily::centred_step(long step) {
 #pragma omp simd
       for (int i = 0; i < b.owned_k(); ++i) next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
     });
-    context_.constraints.hold_positions(next_positions_);
+    context_.constraints.hold_positions(next_positions_, context_.end_time);
     return;
   }
   Field<Vec3>* n_field = normals();
@@ -93,12 +94,12 @@ void VerletFamily::centred_step(long step) {
       next_positions_(k, l) = update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
     });
   }
-  context_.constraints.hold_positions(next_positions_);
+  context_.constraints.hold_positions(next_positions_, context_.end_time);
 }
 
 // The published Verlet: velocity terms lagged, v = (r − r⁻)/Δt; first order (MODEL.md §4).
 void VerletFamily::lagged_step(long step) {
-  context_.constraints.hold_positions(previous_positions_);
+  context_.constraints.hold_positions(previous_positions_, previous_time(dt_previous_));
   const double dt = context_.dt;
   for_owned(context_.block, [&](int k, int l) {
     lagged_velocity_(k, l) = (positions_(k, l) - previous_positions_(k, l)) / dt;
@@ -108,7 +109,7 @@ void VerletFamily::lagged_step(long step) {
     next_positions_(k, l) =
         2.0 * positions_(k, l) - previous_positions_(k, l) + (dt * dt) * acceleration_(k, l);
   });
-  context_.constraints.hold_positions(next_positions_);
+  context_.constraints.hold_positions(next_positions_, context_.end_time);
 }
 
 void VerletFamily::accept_state() {

@@ -173,6 +173,16 @@ TEST_F(Cli, BadSolidIsBadInputAndWritesNothing) {
   EXPECT_FALSE(fs::exists(path("out.h5")));
 }
 
+TEST_F(Cli, BadFixVelocityIsBadInputAndWritesNothing) {
+  const std::string scene = write_scene(
+      "velocity.toml",
+      std::string(kSmallScene) + "[[fix]]\nnodes = [[5, 5]]\nvelocity = [0.1, 0.0]\n");
+  const Result r = cosserat("run " + scene + " --output " + path("out.h5"));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("fix[1].velocity"));
+  EXPECT_FALSE(fs::exists(path("out.h5")));
+}
+
 TEST_F(Cli, UnwritableOutputIsBadInput) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   const Result r = cosserat("run " + scene + " --output " + path("no/such/dir/out.h5"));

@@ -46,9 +46,11 @@ inline std::vector<Decomposition> all_splits(int m, int n, int ranks) {
 }
 
 // 37 x 23, odd in both directions, so every split is uneven. Two corners held from the start;
-// a band fixed in y only from step 30; a load on a disk for steps 0-50; fluid and damping, so
-// that the total area enters every step. The band, the disk and the fixed corners straddle the
-// block borders of every split of 2 to 6 ranks.
+// a band fixed in y only from step 30; two nodes moved in x and z by a fix from step 20 to 55
+// and then held in x where they got to (a restart at half the 80 steps lands while they move);
+// a load on a disk for steps 0-50; fluid and damping, so that the total area enters every step.
+// The band, the disk and the fixed corners straddle the block borders of every split of 2 to 6
+// ranks.
 inline Scene odd_grid_scene(Integrator integrator) {
   Scene scene = parse_scene(R"(
 title = "odd grid"
@@ -78,6 +80,16 @@ nodes = [[0, 0], [36, 0]]
 region = { rect = [10, 8, 26, 13] }
 axes = "y"
 start = 30
+[[fix]]
+nodes = [[18, 22], [5, 3]]
+axes = "xz"
+velocity = [0.5, 0.0, -0.3]
+start = 20
+end = 55
+[[fix]]
+nodes = [[18, 22], [5, 3]]
+axes = "x"
+start = 55
 [[load]]
 region = { disk = { center = [18, 11], radius = 6 } }
 force = [0.0, 2.0, 0.3]
@@ -110,7 +122,8 @@ inline Scene semi_implicit_odd_grid_scene() {
 
 // Adaptive steps that roll back: the bending sheet (support/sheets.hpp) at safety 1, so that the
 // monitor trips and the run goes back (tests/unit/test_adaptive_steps.cpp); a load on a disk
-// straddling the block borders for its first 0.05 s, and two corners held.
+// straddling the block borders for its first 0.05 s, two corners held, and the middle of the
+// far edge lifted by a moving fix from 0.02 s to 0.15 s.
 inline Scene rolling_back_scene(Integrator integrator) {
   Scene scene = parse_scene(bending_sheet_text() + R"(
 [time]
@@ -119,6 +132,12 @@ output_dt = 0.1
 dt = { adaptive = true, safety = 1.0 }
 [[fix]]
 nodes = [[0, 0], [23, 0]]
+[[fix]]
+nodes = [[12, 23]]
+axes = "y"
+velocity = [0.0, 0.2, 0.0]
+start_time = 0.02
+end_time = 0.15
 [[load]]
 region = { disk = { center = [12, 11], radius = 5 } }
 force = [0.0, 0.05, 0.01]

@@ -230,6 +230,10 @@ TEST_F(Restart, RefusesACheckpointWhoseContentsTheSceneCannotContinue) {
   overwrite<double>(checkpoint(), "/constraint_values", {0, 0}, {1, 3}, H5T_NATIVE_DOUBLE,
                     {0.0, 0.0, std::numeric_limits<double>::infinity()});
   expect_refused("not finite");
+  write();
+  overwrite<double>(checkpoint(), "/constraint_velocities", {0, 0}, {1, 3}, H5T_NATIVE_DOUBLE,
+                    {nan, 0.0, 0.0});
+  expect_refused("m/s: not finite");
 
   write(nan);
   expect_refused("peak kinetic energy is nan");
@@ -249,6 +253,31 @@ TEST_F(Restart, RefusesACheckpointWhoseContentsTheSceneCannotContinue) {
   }
   MPI_Barrier(MPI_COMM_WORLD);
   expect_refused("/positions is [37, 24, 3], not the [37, 23, 3] of this grid");
+}
+
+// Checkpoints from before fixes could move lack /constraint_since and /constraint_velocities:
+// every fix was still then, and such a checkpoint restarts bitwise as if they held zeros (here
+// one written at step 5, before the odd grid's moving fix switches on at step 20).
+TEST_F(Restart, ACheckpointWithoutFixVelocitiesRestartsBitwise) {
+  Scene scene = testing::odd_grid_scene(Integrator::verlet);
+  Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(uninterrupted, scene.steps));
+  {
+    Simulation first(scene, MPI_COMM_WORLD, any_scheme);
+    ASSERT_TRUE(testing::advance(first, 5));
+    write_checkpoint(checkpoint(), first, scene, "test");
+  }
+  if (world_rank() == 0) {
+    const hid_t f = H5Fopen(checkpoint().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    EXPECT_GE(H5Ldelete(f, "/constraint_since", H5P_DEFAULT), 0);
+    EXPECT_GE(H5Ldelete(f, "/constraint_velocities", H5P_DEFAULT), 0);
+    EXPECT_GE(H5Fclose(f), 0);
+  }
+  MPI_Barrier(MPI_COMM_WORLD);
+  Simulation restarted(scene, MPI_COMM_WORLD, any_scheme);
+  EXPECT_EQ(read_checkpoint(checkpoint(), restarted, scene), 5);
+  ASSERT_TRUE(testing::advance(restarted, scene.steps - 5));
+  EXPECT_EQ(differing_nodes(restarted.positions(), uninterrupted.positions()), 0);
 }
 
 using Output = SharedFolder;

@@ -172,6 +172,28 @@ TEST(AdaptiveSteps, RollsBackAndFinishesWhereASafeRunEnds) {
   EXPECT_GT(careful.step_index(), fast.step_index());
 }
 
+// A moving fix under adaptive steps, through roll-backs: its node ends exactly where its
+// velocity takes it in the run's time, whatever steps were taken or undone.
+TEST(AdaptiveSteps, AMovingFixFollowsItsVelocityThroughRollBacks) {
+  Scene scene = adaptive_sheet(
+      "duration = 0.2\noutput_dt = 0.1\ndt = { adaptive = true, safety = 1.0 }");
+  Fix lifted = testing::fix_nodes({{23, 23}});
+  lifted.velocity = {0.1, 0.5, -0.2};
+  scene.fixes.push_back(lifted);
+  Simulation simulation(scene, MPI_COMM_SELF);
+  const Vec3 start = simulation.positions()(23, 23);
+  Recorder recorder(simulation);
+  const StepLoopResult result = run_step_loop(simulation, scene, {}, recorder);
+  ASSERT_FALSE(result.failure);
+  ASSERT_TRUE(result.adaptive);
+  EXPECT_GE(result.adaptive->rollbacks, 1);
+  EXPECT_EQ(simulation.time(), 0.2);
+  const Vec3 r = simulation.positions()(23, 23);
+  EXPECT_EQ(r.x, start.x + lifted.velocity.x * 0.2);
+  EXPECT_EQ(r.y, start.y + lifted.velocity.y * 0.2);
+  EXPECT_EQ(r.z, start.z + lifted.velocity.z * 0.2);
+}
+
 // A run that needs a step below time.dt.min is unstable (exit 3), and says so.
 TEST(AdaptiveSteps, BelowTheSmallestStepTheRunIsUnstable) {
   const Scene scene = adaptive_sheet(

@@ -218,6 +218,35 @@ TEST(Scene, FixDefaultsHoldEveryAxisForTheWholeRun) {
   EXPECT_EQ(fix.axes, (std::array<bool, 3>{true, true, true}));
   EXPECT_EQ(fix.window.start, 0);
   EXPECT_EQ(fix.window.end, std::numeric_limits<long>::max());
+  EXPECT_EQ(norm(fix.velocity), 0.0);  // a still fix
+}
+
+TEST(Scene, FixVelocityIsRead) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[1, 1]]\naxes = \"xz\"\nvelocity = [-0.25, 0, 1]\n";
+  const Vec3 v = parse(text).fixes.at(0).velocity;
+  EXPECT_EQ(v.x, -0.25);
+  EXPECT_EQ(v.y, 0.0);
+  EXPECT_EQ(v.z, 1.0);
+}
+
+// A velocity that is not 3 finite numbers, or moves an axis the fix leaves free, is refused
+// naming the key.
+TEST(SceneError, FixVelocity) {
+  SceneText text;
+  const std::string fix = "[[fix]]\nnodes = [[1, 1]]\n";
+  text.tail = fix + "velocity = [0.1, 0.0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].velocity'"),
+                                    HasSubstr("an array of 3 numbers")));
+  text.tail = fix + "velocity = [0.1, nan, 0.0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("fix[0].velocity"), HasSubstr("finite")));
+  text.tail = fix + "velocity = [0.1, 0.0, inf]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("fix[0].velocity"), HasSubstr("finite")));
+  text.tail = fix + "velocity = 0.1\n";
+  EXPECT_THAT(error_of(text), HasSubstr("key 'fix[0].velocity'"));
+  text.tail = fix + "axes = \"yz\"\nvelocity = [0.1, 0.0, 0.0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].velocity'"),
+                                    HasSubstr("moves along x, which this fix does not hold")));
 }
 
 TEST(Scene, PresetGivesEverythingAndScalesMassToTheSheet) {

@@ -54,6 +54,9 @@ struct Fix {
   NodeSet nodes;
   std::array<bool, 3> axes{true, true, true};
   Window window;
+  // m/s: the held components move at this velocity from the moment they are held (0 on every
+  // axis the fix does not hold).
+  Vec3 velocity{};
 };
 
 struct Load {

@@ -1,5 +1,6 @@
 #pragma once
-// Fixed nodes with axis masks and windows in steps and seconds (MODEL.md §4.1), for the nodes this block owns.
+// Fixed nodes with axis masks, windows in steps and seconds and prescribed velocities
+// (MODEL.md §4.1, docs/scene-format.md "Fixes and loads"), for the nodes this block owns.
 
 #include <cstdint>
 #include <vector>
@@ -15,21 +16,32 @@ class Constraints {
   Constraints(const std::vector<Fix>& fixes, const Block& block);
 
   // Switches the fixes acting during `step`, which starts at `time`, on and off. A component
-  // that becomes held keeps the value it has now (MODEL.md §4.1), not its rest value.
+  // that becomes held, or whose held velocity changes, is held from the value it has now
+  // (MODEL.md §4.1), not its rest value.
   void begin_step(long step, double time, const Field<Vec3>& positions);
 
-  // Held components back to their held value / to zero velocity.
-  void hold_positions(Field<Vec3>& positions) const;
+  // Held components to their held value at `time` (the time the field belongs to) / to their
+  // held velocity.
+  void hold_positions(Field<Vec3>& positions, double time) const;
   void hold_velocities(Field<Vec3>& velocities) const;
 
   bool empty() const { return nodes_.empty(); }
 
   // What begin_step carries from one step to the next, per constrained node of this block:
-  // which components are held and the values they are held at. For checkpoints.
+  // which components are held, and for each the value and time it was taken at and the
+  // velocity it moves at since. For checkpoints and the semi-implicit solve.
   struct NodeState {
     int k, l;
     std::uint8_t held;
     Vec3 value;
+    Vec3 since{};     // s
+    Vec3 velocity{};  // m/s
+
+    // Where held component c is at `time`: a function of the node and time alone, so the same
+    // on every decomposition and after a restart.
+    double position(int c, double time) const {
+      return velocity[c] == 0.0 ? value[c] : value[c] + velocity[c] * (time - since[c]);
+    }
   };
   std::vector<NodeState> state() const;
   // Takes over the entries for this block's constrained nodes; others are ignored.
@@ -39,12 +51,11 @@ class Constraints {
   struct AxesWindow {
     std::uint8_t axes;  // bit c set: component c held
     Window window;
+    Vec3 velocity;
   };
   struct HeldNode {
-    int k, l;
-    std::vector<AxesWindow> windows;
-    std::uint8_t held = 0;
-    Vec3 value;
+    std::vector<AxesWindow> windows;  // in the scene's order: a later fix wins
+    NodeState state;
   };
   std::vector<HeldNode> nodes_;
 };

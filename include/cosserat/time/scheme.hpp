@@ -40,7 +40,8 @@ struct StepContext {
   Dynamics& dynamics;
   Constraints& constraints;
   double dt;
-  double time = 0.0;  // at the start of the step
+  double time = 0.0;      // at the start of the step
+  double end_time = 0.0;  // at its end, as the Stepper counts it (held positions move with it)
 };
 
 class Scheme {
@@ -91,11 +92,11 @@ class Scheme {
   // Together with the step index and the constraints' state, all a restart needs.
   virtual std::vector<StateField> state_fields() = 0;
 
-  // The next step's size and start time: a fixed step sets them once, adaptive steps before
-  // every step.
-  void set_step(double dt, double time) {
+  // The next step's size, start and end time, before every step.
+  void set_step(double dt, double time, double end_time) {
     context_.dt = dt;
     context_.time = time;
+    context_.end_time = end_time;
   }
 
   // The semi-implicit baseline's linear solves; nothing for the explicit schemes.
@@ -116,7 +117,13 @@ class Scheme {
 
   // Where the fluid term's normals go, or null when the scene has no fluid.
   Field<Vec3>* normals() { return context_.dynamics.has_fluid() ? &normals_ : nullptr; }
-  void hold(Field<Vec3>& r, Field<Vec3>& v) const;
+  // Holds a state of the step at `fraction` of it (0: its start, 1: its end).
+  void hold(Field<Vec3>& r, Field<Vec3>& v, double fraction) const;
+  double stage_time(double fraction) const {
+    return fraction == 1.0 ? context_.end_time : context_.time + fraction * context_.dt;
+  }
+  // rⁿ⁻¹ of the Verlet family belongs to the start of the previous step.
+  double previous_time(double dt_previous) const { return context_.time - dt_previous; }
 
   StepContext context_;
   Field<Vec3> positions_;       // rⁿ
