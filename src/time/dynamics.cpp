@@ -30,6 +30,10 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
     for (const NodeIndex& node : load.nodes.nodes)
       if (block.owns(node.k, node.l))
         loads_.push_back(PointLoad{node.k, node.l, load.force, load.window});
+  // In row order, for free_acceleration_rows to find a row's loads; stable, so that a node's
+  // own loads keep the scene's order and their sum its bits.
+  std::stable_sort(loads_.begin(), loads_.end(),
+                   [](const PointLoad& a, const PointLoad& b) { return a.l < b.l; });
   if (discretisation_ == Discretisation::flux)
     flux_.emplace(block, scene.h1(), scene.h2(),
                   flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
@@ -65,7 +69,7 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
     // Newtons on the constant nodal mass μ0 h1 h2 (§2.5), with gravity, written by the kernel;
     // loads, damping and fluid per unit area act on μ0.
     energy_.internal_force(r, a, normals, 1.0 / node_mass_, g);
-    inverse_density = rest_area_ / mass_;
+    inverse_density = rest_inverse_density();
   }
   const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
   const Vec3 fluid_velocity = fluid ? fluid_->velocity : Vec3{};
@@ -99,29 +103,19 @@ void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
                                       const CosseratEnergy::RowConsumer& consume) {
   assert(fuses_rows());
   const Block& b = *block_;
-  // The loads acting now, in row order; a node's own loads keep their order (stable), so their
-  // sum is free_acceleration's.
-  struct RowLoad {
-    int k, l;
-    Vec3 acceleration;
-  };
-  std::vector<RowLoad> active;
-  const double inverse_density = rest_area_ / mass_;
-  for (const PointLoad& load : loads_)
-    if (load.window.contains(step, time_))
-      active.push_back({load.k, load.l, (inverse_density / h1h2_) * load.force});
-  std::stable_sort(active.begin(), active.end(),
-                   [](const RowLoad& a, const RowLoad& b) { return a.l < b.l; });
+  const double load_scale = rest_inverse_density() / h1h2_;
   energy_.internal_force_rows(r, 1.0 / node_mass_, gravity_,
                               [&](int l, double* x, double* y, double* z) {
-    auto load = std::lower_bound(active.begin(), active.end(), l,
-                                 [](const RowLoad& a, int row) { return a.l < row; });
-    for (; load != active.end() && load->l == l; ++load) {
-      const auto i = static_cast<std::size_t>(load->k - b.k0);
-      x[i] += load->acceleration.x;
-      y[i] += load->acceleration.y;
-      z[i] += load->acceleration.z;
-    }
+    auto load = std::lower_bound(loads_.begin(), loads_.end(), l,
+                                 [](const PointLoad& a, int row) { return a.l < row; });
+    for (; load != loads_.end() && load->l == l; ++load)
+      if (load->window.contains(step, time_)) {
+        const auto i = static_cast<std::size_t>(load->k - b.k0);
+        const Vec3 acceleration = load_scale * load->force;
+        x[i] += acceleration.x;
+        y[i] += acceleration.y;
+        z[i] += acceleration.z;
+      }
     consume(l, x, y, z);
   });
 }

@@ -73,26 +73,27 @@ void VerletFamily::centred_step(long step) {
 #pragma omp simd
       for (int i = 0; i < b.owned_k(); ++i) next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
     });
-    context_.constraints.hold_positions(next_positions_, context_.end_time);
-    return;
-  }
-  Field<Vec3>* n_field = normals();
-  const VelocityTerms terms = dynamics.free_acceleration(positions_, step, acceleration_, n_field);
-  const double c = terms.damping * weight / span;
-  const double d = terms.fluid * weight / span;
-  // Two loops rather than a test per node, so that each vectorises.
-  if (d > 0.0) {
-    for_owned(context_.block, [&](int k, int l) {
-      const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
-      const Vec3 n = (*n_field)(k, l);
-      const Vec3 rhs =
-          r + ratio * (r - rp) + weight * acceleration_(k, l) + c * rp + (d * dot(n, rp)) * n;
-      next_positions_(k, l) = solve_centred(rhs, n, c, d);
-    });
   } else {
-    for_owned(context_.block, [&](int k, int l) {
-      next_positions_(k, l) = update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
-    });
+    Field<Vec3>* n_field = normals();
+    const VelocityTerms terms =
+        dynamics.free_acceleration(positions_, step, acceleration_, n_field);
+    const double c = terms.damping * weight / span;
+    const double d = terms.fluid * weight / span;
+    // Two loops rather than a test per node, so that each vectorises.
+    if (d > 0.0) {
+      for_owned(context_.block, [&](int k, int l) {
+        const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
+        const Vec3 n = (*n_field)(k, l);
+        const Vec3 rhs =
+            r + ratio * (r - rp) + weight * acceleration_(k, l) + c * rp + (d * dot(n, rp)) * n;
+        next_positions_(k, l) = solve_centred(rhs, n, c, d);
+      });
+    } else {
+      for_owned(context_.block, [&](int k, int l) {
+        next_positions_(k, l) =
+            update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
+      });
+    }
   }
   context_.constraints.hold_positions(next_positions_, context_.end_time);
 }

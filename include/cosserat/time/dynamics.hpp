@@ -36,7 +36,9 @@ class Dynamics {
     return discretisation_ == Discretisation::energy && !fluid_.has_value();
   }
   // The velocity terms free_acceleration would return; with fuses_rows() only.
-  VelocityTerms row_velocity_terms() const { return VelocityTerms{damping_ * (rest_area_ / mass_), 0.0}; }
+  VelocityTerms row_velocity_terms() const {
+    return VelocityTerms{damping_ * rest_inverse_density(), 0.0};
+  }
   // free_acceleration's `a`, without the field: each finished row goes to `consume` (see
   // CosseratEnergy::internal_force_rows) while it is in cache, so that a scheme's update reads
   // it there. The same bits as free_acceleration's; with fuses_rows() only.
@@ -88,6 +90,9 @@ class Dynamics {
     Vec3 force;
     Window window;
   };
+
+  // 1/μ0 = S0/M, the energy form's constant inverse areal density (MODEL.md §2.5).
+  double rest_inverse_density() const { return rest_area_ / mass_; }
 
   const Block* block_;
   Discretisation discretisation_;
