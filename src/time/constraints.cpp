@@ -1,5 +1,6 @@
 #include "cosserat/time/constraints.hpp"
 
+#include <algorithm>
 #include <map>
 
 namespace cosserat {
@@ -50,6 +51,17 @@ void Constraints::begin_step(long step, double time, const Field<Vec3>& position
 void Constraints::hold_positions(Field<Vec3>& positions, double time) const {
   for (const HeldNode& node : nodes_) {
     const NodeState& s = node.state;
+    Vec3& r = positions(s.k, s.l);
+    for (int c = 0; c < 3; ++c)
+      if (s.held & (1u << c)) r[c] = s.position(c, time);
+  }
+}
+
+void Constraints::hold_row(Field<Vec3>& positions, int l, double time) const {
+  auto node = std::lower_bound(nodes_.begin(), nodes_.end(), l,
+                               [](const HeldNode& n, int row) { return n.state.l < row; });
+  for (; node != nodes_.end() && node->state.l == l; ++node) {
+    const NodeState& s = node->state;
     Vec3& r = positions(s.k, s.l);
     for (int c = 0; c < 3; ++c)
       if (s.held & (1u << c)) r[c] = s.position(c, time);

@@ -30,8 +30,9 @@ Stepper::Stepper(const Scene& scene, const Decomposition& decomposition, const B
       dt_(first_step(scene)),
       h1_(scene.h1()),
       h2_(scene.h2()),
-      max_move_(0.5 * std::min(scene.h1(), scene.h2())) {
-  const StepContext context{block, halo, dynamics, constraints_, dt_};
+      max_move_(0.5 * std::min(scene.h1(), scene.h2())),
+      edge_check_(block, max_move_) {
+  const StepContext context{block, halo, dynamics, constraints_, dt_, 0.0, 0.0, &edge_check_};
   scheme_ = make(SchemeSetup{scene, decomposition, context, positions});
   scheme_->begin(std::move(velocities));
 }
@@ -44,6 +45,7 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
   scheme_->set_step(dt, time_, end_time);
   dynamics_->set_time(time_);
   constraints_.begin_step(step_, time_, scheme_->positions());
+  edge_check_.arm(actions_.empty());
   if (auto solver_failure = scheme_->advance(step_)) {
     return Instability{step_ + 1, end_time, -1, -1, false, std::move(solver_failure), {}};
   }
@@ -97,7 +99,7 @@ void Stepper::restore(const Snapshot& s) {
 // that moved more is blamed (both ends on a tie); the first node blamed in (l, k) order is
 // reported, the same for any thread count and decomposition, since the ghosts of both states
 // are exchanged.
-std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_time) const {
+std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_time) {
   const Block& b = *block_;
   const Field<Vec3>& r = scheme_->positions();
   const double limit2 = max_move_ * max_move_;
@@ -118,36 +120,14 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_ti
            (l + 1 < b.n && too_far(move, k, l + 1));
   };
   // A node fails only if one of its edges changed by more than the limit, or its position is
-  // not finite (then so is some edge's change). A pass that tests every edge of a row's nodes,
-  // without the early exit, vectorises; only a row it flags is scanned for its first failing
-  // node. The grid's first and last columns, whose missing neighbours the pass would read, are
-  // tested node by node.
-  auto row_may_fail = [&](int l) {
-    const int ka = std::max(b.k0, 1), kb = std::min(b.k1, b.m - 1);
-    if ((b.k0 == 0 && fails(0, l)) || (b.k1 == b.m && fails(b.m - 1, l))) return true;
-    if (ka >= kb) return false;
-    // A missing row above or below is replaced by the row itself, whose edges to itself are 0.
-    const int below = l > 0 ? l - 1 : l, above = l + 1 < b.n ? l + 1 : l;
-    const Vec3 *p = &next(ka, l), *q = &r(ka, l);
-    const Vec3 *p_below = &next(ka, below), *q_below = &r(ka, below);
-    const Vec3 *p_above = &next(ka, above), *q_above = &r(ka, above);
-    bool flagged = false;
-#pragma omp simd reduction(| : flagged)
-    for (int i = 0; i < kb - ka; ++i) {
-      const Vec3 move = p[i] - q[i];
-      auto changed = [&](const Vec3& neighbour_move) {
-        const Vec3 relative = move - neighbour_move;
-        return !(dot(relative, relative) <= limit2);
-      };
-      flagged |= changed(p[i - 1] - q[i - 1]) | changed(p[i + 1] - q[i + 1]) |
-                 changed(p_below[i] - q_below[i]) | changed(p_above[i] - q_above[i]);
-    }
-    return flagged;
-  };
+  // not finite (then so does every edge of it): only a row with such an edge, which the edge
+  // test finds without an early exit (and in the Verlet step while the rows are in cache), is
+  // scanned for its first failing node.
+  const std::vector<char>& may_fail = edge_check_.flag_rows(r, next);
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l) {
-    if (!row_may_fail(l)) continue;
     const auto row = static_cast<std::size_t>(l - b.l0);
+    if (!may_fail[row]) continue;
     for (int k = b.k0; k < b.k1; ++k) {
       if (fails(k, l)) {
         first_bad[row] = static_cast<long>(l) * b.m + k;

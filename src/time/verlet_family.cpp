@@ -63,37 +63,45 @@ void VerletFamily::centred_step(long step) {
   };
   if (dynamics.fuses_rows()) {
     // Each row of a is used while the kernel still has it in cache, and never stored: the
-    // step's largest sweep of memory saved (docs/kernel.md).
+    // step's largest sweep of memory saved (docs/kernel.md). The row is held, and the
+    // stability check's edge test reads it, while it is still there too.
     const double c = dynamics.row_velocity_terms().damping * weight / span;
     const Block& b = context_.block;
+    const Constraints& constraints = context_.constraints;
+    EdgeCheck* edges = context_.edge_check != nullptr && context_.edge_check->armed()
+                           ? context_.edge_check
+                           : nullptr;
+    if (edges != nullptr) edges->begin_walk();
     dynamics.free_acceleration_rows(positions_, step, [&](int l, double* x, double* y, double* z) {
       const Vec3* r = &positions_(b.k0, l);
       const Vec3* rp = &previous_positions_(b.k0, l);
       Vec3* next = &next_positions_(b.k0, l);
 #pragma omp simd
       for (int i = 0; i < b.owned_k(); ++i) next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
+      constraints.hold_row(next_positions_, l, context_.end_time);
+      if (edges != nullptr) edges->walk_row(l, positions_, next_positions_);
+    });
+    return;
+  }
+  Field<Vec3>* n_field = normals();
+  const VelocityTerms terms =
+      dynamics.free_acceleration(positions_, step, acceleration_, n_field);
+  const double c = terms.damping * weight / span;
+  const double d = terms.fluid * weight / span;
+  // Two loops rather than a test per node, so that each vectorises.
+  if (d > 0.0) {
+    for_owned(context_.block, [&](int k, int l) {
+      const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
+      const Vec3 n = (*n_field)(k, l);
+      const Vec3 rhs =
+          r + ratio * (r - rp) + weight * acceleration_(k, l) + c * rp + (d * dot(n, rp)) * n;
+      next_positions_(k, l) = solve_centred(rhs, n, c, d);
     });
   } else {
-    Field<Vec3>* n_field = normals();
-    const VelocityTerms terms =
-        dynamics.free_acceleration(positions_, step, acceleration_, n_field);
-    const double c = terms.damping * weight / span;
-    const double d = terms.fluid * weight / span;
-    // Two loops rather than a test per node, so that each vectorises.
-    if (d > 0.0) {
-      for_owned(context_.block, [&](int k, int l) {
-        const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
-        const Vec3 n = (*n_field)(k, l);
-        const Vec3 rhs =
-            r + ratio * (r - rp) + weight * acceleration_(k, l) + c * rp + (d * dot(n, rp)) * n;
-        next_positions_(k, l) = solve_centred(rhs, n, c, d);
-      });
-    } else {
-      for_owned(context_.block, [&](int k, int l) {
-        next_positions_(k, l) =
-            update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
-      });
-    }
+    for_owned(context_.block, [&](int k, int l) {
+      next_positions_(k, l) =
+          update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
+    });
   }
   context_.constraints.hold_positions(next_positions_, context_.end_time);
 }

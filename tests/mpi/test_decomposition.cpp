@@ -10,7 +10,9 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/grid/halo.hpp"
@@ -195,6 +197,48 @@ TEST(DecompositionInvariance, GustingFlagFollowsTheOneBlockTrajectory) {
         EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0) << run;
         EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0) << run;
       });
+}
+
+// Runs until the stability check stops the run, at most `steps` steps.
+std::optional<Instability> run_until_unstable(Simulation& sim, long steps) {
+  for (long s = 0; s < steps; ++s)
+    if (auto failure = sim.step()) return failure;
+  return std::nullopt;
+}
+
+// S2 at a step past its stable one becomes unstable: the check stops every split and thread
+// count at the step and node it stops the one-block run, the first failing node in (l, k) order
+// whichever rank and thread holds it. For Verlet, whose row walk tests most edges while the rows
+// are in cache, at 0.0065 s (the rest sheet's CFL estimate is 0.0063 s; node [3, 2] at step 28
+// when written); for RK4, whose check tests them all in a pass of its own, at 0.008 s (node
+// [6, 6] at step 397).
+TEST(DecompositionInvariance, AnUnstableRunStopsAtTheSameStepAndNodeOnEverySplit) {
+  for (const auto& [integrator, dt] :
+       {std::pair{Integrator::verlet, 0.0065}, std::pair{Integrator::rk4, 0.008}}) {
+    Scene scene = s2_cape(500);
+    scene.integrator = integrator;
+    scene.dt = dt;
+    const long steps = scene.steps;
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+    const std::optional<Instability> expected = run_until_unstable(reference, steps);
+    ASSERT_TRUE(expected.has_value()) << integrator_name(integrator);
+    const int default_threads = omp_get_max_threads();
+    for (const int threads : {1, 3})
+      for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+        omp_set_num_threads(threads);
+        Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+        const std::optional<Instability> failure = run_until_unstable(sim, steps);
+        omp_set_num_threads(default_threads);
+        const std::string run = integrator_name(integrator) + ", split " + split_name(d) + ", " +
+                                std::to_string(threads) + " threads";
+        ASSERT_TRUE(failure.has_value()) << run;
+        EXPECT_EQ(failure->step, expected->step) << run;
+        EXPECT_EQ(failure->k, expected->k) << run;
+        EXPECT_EQ(failure->l, expected->l) << run;
+        EXPECT_EQ(failure->not_finite, expected->not_finite) << run;
+        EXPECT_EQ(sim.step_index(), expected->step - 1) << run;
+      }
+  }
 }
 
 // An observer of nothing: the adaptive step loop's choices alone are compared.

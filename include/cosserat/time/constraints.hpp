@@ -23,6 +23,8 @@ class Constraints {
   // Held components to their held value at `time` (the time the field belongs to) / to their
   // held velocity.
   void hold_positions(Field<Vec3>& positions, double time) const;
+  // The same for the nodes of row l only, for a scheme that finishes a field row by row.
+  void hold_row(Field<Vec3>& positions, int l, double time) const;
   void hold_velocities(Field<Vec3>& velocities) const;
 
   bool empty() const { return nodes_.empty(); }
@@ -57,7 +59,7 @@ class Constraints {
     std::vector<AxesWindow> windows;  // in the scene's order: a later fix wins
     NodeState state;
   };
-  std::vector<HeldNode> nodes_;
+  std::vector<HeldNode> nodes_;  // in (l, k) order
 };
 
 }  // namespace cosserat

@@ -17,6 +17,7 @@
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
 #include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/edge_check.hpp"
 #include "cosserat/time/linear_solve_stats.hpp"
 
 namespace cosserat {
@@ -42,6 +43,9 @@ struct StepContext {
   double dt;
   double time = 0.0;      // at the start of the step
   double end_time = 0.0;  // at its end, as the Stepper counts it (held positions move with it)
+  // The stability check's edge test, for a scheme that finishes r⁺ row by row to run while
+  // the rows are in cache; null where no check follows.
+  EdgeCheck* edge_check = nullptr;
 };
 
 class Scheme {

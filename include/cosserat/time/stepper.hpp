@@ -116,7 +116,7 @@ class Stepper {
   std::optional<LinearSolveStats> linear_solves() const { return scheme_->linear_solves(); }
 
  private:
-  std::optional<Instability> check(const Field<Vec3>& next, double end_time) const;
+  std::optional<Instability> check(const Field<Vec3>& next, double end_time);
 
   const Block* block_;
   Dynamics* dynamics_;
@@ -124,6 +124,7 @@ class Stepper {
   double dt_;
   double h1_, h2_;
   double max_move_;  // half the smaller grid spacing (MODEL.md §4.2)
+  EdgeCheck edge_check_;
   long step_ = 0;
   double time_ = 0.0;
   std::unique_ptr<Scheme> scheme_;
