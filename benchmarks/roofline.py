@@ -51,12 +51,16 @@ def plot(spec, path):
     top = max(compute.values())
     x_lo = min([0.05] + [0.3 * i for i in intensities])
     x_hi = max([100.0] + [3 * i for i in intensities])
-    # Room below the lowest point for the legend.
-    y_lo = min([0.5] + [0.05 * k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
+    y_lo = min([0.5] + [0.3 * k["flops_per_node_step"] * k["node_steps_per_second"] / 1e9
                         for k in kernels])
     x = np.logspace(np.log10(x_lo), np.log10(x_hi), 400)
 
-    fig, ax = plt.subplots(figsize=(9, 6.5))
+    # The legend in a panel of its own under the plot, so that it hides no point however many.
+    legend_height = 0.42 * len(kernels)
+    fig, (ax, legend_ax) = plt.subplots(
+        2, 1, figsize=(9, 5.5 + legend_height),
+        gridspec_kw={"height_ratios": [5.5, legend_height]})
+    legend_ax.axis("off")
     for i, (name, gbs) in enumerate(sorted(bandwidth.items(), key=lambda item: -item[1])):
         ax.plot(x, np.minimum(x * gbs, top), color=f"C{i}", lw=1.6)
         # Labelled along the diagonal, where it is still below the highest roof.
@@ -80,7 +84,7 @@ def plot(spec, path):
                       f"{gflops:.2f} GFLOP/s,\n{gflops / limit:.1%} of its bound ({limit:.1f} "
                       f"GFLOP/s, {limit_name}); {k['flops_per_node_step']:.0f} flops, "
                       f"{k['bytes_per_node_step']:.0f} B per node-step")
-    ax.legend(loc="lower right", fontsize=7.5, framealpha=0.9)
+    legend_ax.legend(*ax.get_legend_handles_labels(), loc="center", fontsize=7.5, frameon=False)
 
     ax.set_xscale("log")
     ax.set_yscale("log")
@@ -92,7 +96,7 @@ def plot(spec, path):
     ax.grid(True, which="both", lw=0.3, alpha=0.5)
     if spec.get("note"):
         fig.text(0.01, 0.005, textwrap.fill(spec["note"], 150), fontsize=7, va="bottom")
-    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fig.tight_layout(rect=(0, 0.03, 1, 1))
     fig.savefig(path, dpi=130)
 
 
