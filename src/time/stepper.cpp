@@ -120,9 +120,9 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_ti
            (l + 1 < b.n && too_far(move, k, l + 1));
   };
   // A node fails only if one of its edges changed by more than the limit, or its position is
-  // not finite (then so does every edge of it): only a row with such an edge, which the edge
-  // test finds without an early exit (and in the Verlet step while the rows are in cache), is
-  // scanned for its first failing node.
+  // not finite (and then every edge of it fails the edge test too): only a row with such an
+  // edge, which the edge test finds without an early exit (in the Verlet step while the rows
+  // are still in cache), is scanned for its first failing node.
   const std::vector<char>& may_fail = edge_check_.flag_rows(r, next);
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l) {
