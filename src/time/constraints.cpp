@@ -5,6 +5,15 @@
 
 namespace cosserat {
 
+namespace {
+// Node s's held components to their held value at `time`.
+void hold(const Constraints::NodeState& s, Field<Vec3>& positions, double time) {
+  Vec3& r = positions(s.k, s.l);
+  for (int c = 0; c < 3; ++c)
+    if (s.held & (1u << c)) r[c] = s.position(c, time);
+}
+}  // namespace
+
 Constraints::Constraints(const std::vector<Fix>& fixes, const Block& block) {
   // Several fixes may hold one node: gather them per node, in a fixed (l, k) order.
   std::map<std::pair<int, int>, std::vector<AxesWindow>> by_node;
@@ -49,23 +58,13 @@ void Constraints::begin_step(long step, double time, const Field<Vec3>& position
 }
 
 void Constraints::hold_positions(Field<Vec3>& positions, double time) const {
-  for (const HeldNode& node : nodes_) {
-    const NodeState& s = node.state;
-    Vec3& r = positions(s.k, s.l);
-    for (int c = 0; c < 3; ++c)
-      if (s.held & (1u << c)) r[c] = s.position(c, time);
-  }
+  for (const HeldNode& node : nodes_) hold(node.state, positions, time);
 }
 
 void Constraints::hold_row(Field<Vec3>& positions, int l, double time) const {
   auto node = std::lower_bound(nodes_.begin(), nodes_.end(), l,
                                [](const HeldNode& n, int row) { return n.state.l < row; });
-  for (; node != nodes_.end() && node->state.l == l; ++node) {
-    const NodeState& s = node->state;
-    Vec3& r = positions(s.k, s.l);
-    for (int c = 0; c < 3; ++c)
-      if (s.held & (1u << c)) r[c] = s.position(c, time);
-  }
+  for (; node != nodes_.end() && node->state.l == l; ++node) hold(node->state, positions, time);
 }
 
 void Constraints::hold_velocities(Field<Vec3>& velocities) const {

@@ -24,19 +24,11 @@ EdgeCheck::EdgeCheck(const Block& block, double limit)
       may_fail_(static_cast<std::size_t>(block.owned_l()), 0),
       below_done_(static_cast<std::size_t>(block.owned_l()), 0) {}
 
-// Edges (k, k + 1) of row l for k in [ka, kb − 1).
-bool EdgeCheck::horizontal(int l, int ka, int kb, const Field<Vec3>& r,
-                           const Field<Vec3>& next) const {
-  if (kb - ka < 2) return false;
-  const Vec3 *p = &next(ka, l), *q = &r(ka, l);
-  const double limit2 = limit2_;
-  int flagged = 0;
-#pragma omp simd reduction(| : flagged)
-  for (int i = 0; i < kb - ka - 1; ++i)
-    flagged |= changed(p[i].x - q[i].x, p[i].y - q[i].y, p[i].z - q[i].z,
-                       p[i + 1].x - q[i + 1].x, p[i + 1].y - q[i + 1].y,
-                       p[i + 1].z - q[i + 1].z, limit2);
-  return flagged != 0;
+// The one edge from node (ka, la) to node (kb, lb).
+bool EdgeCheck::edge(int ka, int la, int kb, int lb, const Field<Vec3>& r,
+                     const Field<Vec3>& next) const {
+  const Vec3 a = next(ka, la) - r(ka, la), b = next(kb, lb) - r(kb, lb);
+  return changed(a.x, a.y, a.z, b.x, b.y, b.z, limit2_) != 0;
 }
 
 // Edges (la, la + 1) of columns [ka, kb).
@@ -122,8 +114,8 @@ const std::vector<char>& EdgeCheck::flag_rows(const Field<Vec3>& r, const Field<
   // The edges to the ghost columns.
   if (b.k0 > 0 || b.k1 < b.m)
     for (int l = b.l0; l < b.l1; ++l) {
-      if ((b.k0 > 0 && horizontal(l, b.k0 - 1, b.k0 + 1, r, next)) ||
-          (b.k1 < b.m && horizontal(l, b.k1 - 1, b.k1 + 1, r, next)))
+      if ((b.k0 > 0 && edge(b.k0 - 1, l, b.k0, l, r, next)) ||
+          (b.k1 < b.m && edge(b.k1 - 1, l, b.k1, l, r, next)))
         flag(l);
     }
   // A lone node has no edge: only its own test can fail it.

@@ -36,7 +36,7 @@ class EdgeCheck {
   const std::vector<char>& flag_rows(const Field<Vec3>& r, const Field<Vec3>& next);
 
  private:
-  bool horizontal(int l, int ka, int kb, const Field<Vec3>& r, const Field<Vec3>& next) const;
+  bool edge(int ka, int la, int kb, int lb, const Field<Vec3>& r, const Field<Vec3>& next) const;
   bool vertical(int la, int ka, int kb, const Field<Vec3>& r, const Field<Vec3>& next) const;
 
   const Block* block_;
