@@ -248,22 +248,7 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
   double* G = s.gradient.data();
   double* N = s.normal.data();
   const energy::InteriorCoefficients& co = interior_;
-  // Before each block, the same columns of the rows ahead are asked for (into L2, locality 2):
-  // a block of kLanes nodes spans three 64-byte lines of a row, and the rows ahead start at
-  // column gk0 = k_base + 1. Spread over the blocks, the requests never queue up.
-  static_assert(kLanes * sizeof(Vec3) == 3 * 64);
-  auto fetch_ahead = [&](int block) {
-    const long first = (block - 1) * static_cast<long>(sizeof(Vec3));
-    for (const RowScratch::Ahead& a : s.ahead)
-      for (long byte = std::max(first, 0L); byte < std::min(first + 192, a.bytes); byte += 64) {
-        if (a.write)
-          __builtin_prefetch(a.first + byte, 1, 2);
-        else
-          __builtin_prefetch(a.first + byte, 0, 2);
-      }
-  };
   for (int block = ka - k_base; block < kb - k_base; block += kLanes) {
-    fetch_ahead(block);
 #pragma omp simd
     for (int lane = 0; lane < kLanes; ++lane) {
       const std::size_t c = static_cast<std::size_t>(block + lane);
@@ -311,8 +296,7 @@ void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
 
 template <bool Bending, bool Coupling, bool Normal>
 void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double scale,
-                          const Vec3& offset, const RowConsumer& consume,
-                          std::span<const RowField> fields, int qa, int qb,
+                          const Vec3& offset, const RowConsumer& consume, int qa, int qb,
                           RowScratch& s) const {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
@@ -345,16 +329,6 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
       load_row(R, l - 1, k_base, k_end, s);
       load_row(R, l, k_base, k_end, s);
       load_row(R, l + 1, k_base, k_end, s);
-      // The positions the next row's gradients will load, and the consumer's fields at the
-      // row these gradients finish.
-      s.ahead.clear();
-      auto ahead = [&](const Field<Vec3>& field, int row, int k_end_row, bool write) {
-        s.ahead.push_back({reinterpret_cast<const char*>(&field(gk0, row)),
-                           static_cast<long>((k_end_row - gk0) * sizeof(Vec3)), write});
-      };
-      if (l + 2 <= pb && l + 2 < b.n) ahead(R, l + 2, k_end, false);
-      if (l - 1 >= qa && l - 1 < qb)
-        for (const RowField& f : fields) ahead(*f.field, l - 1, b.k1, f.write);
       if (ka < kb) interior_row<Bending, Coupling, Normal>(l, ka, kb, k_base, s);
       if (gk0 == 0) border_node(R, 0, l, k_base, s);
       if (gk1 == b.m) border_node(R, b.m - 1, l, k_base, s);
@@ -419,30 +393,24 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
 void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
                                     Field<Vec3>* normals, double scale, const Vec3& offset) {
   const Block& b = *block_;
-  const RowField written[] = {{&force, true}};
-  all_bands(
-      r, normals, scale, offset,
-      [&](int l, const double* x, const double* y, const double* z) {
-        double* out = &force(b.k0, l).x;  // three packed doubles a node, as load_row reads them
+  all_bands(r, normals, scale, offset, [&](int l, const double* x, const double* y, const double* z) {
+    double* out = &force(b.k0, l).x;  // three packed doubles a node, as load_row reads them
 #pragma omp simd
-        for (int i = 0; i < b.owned_k(); ++i) {
-          out[3 * i] = x[i];
-          out[3 * i + 1] = y[i];
-          out[3 * i + 2] = z[i];
-        }
-      },
-      written);
+    for (int i = 0; i < b.owned_k(); ++i) {
+      out[3 * i] = x[i];
+      out[3 * i + 1] = y[i];
+      out[3 * i + 2] = z[i];
+    }
+  });
 }
 
 void CosseratEnergy::internal_force_rows(const Field<Vec3>& r, double scale, const Vec3& offset,
-                                         const RowConsumer& consume,
-                                         std::span<const RowField> fields) {
-  all_bands(r, nullptr, scale, offset, consume, fields);
+                                         const RowConsumer& consume) {
+  all_bands(r, nullptr, scale, offset, consume);
 }
 
 void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, double scale,
-                               const Vec3& offset, const RowConsumer& consume,
-                               std::span<const RowField> fields) {
+                               const Vec3& offset, const RowConsumer& consume) {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   // Columns from gk0 − 1 to gk1, and the last interior block's lanes past it.
@@ -462,18 +430,18 @@ void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, doubl
     if (qa < qb) {
       if (normals != nullptr) {
         if (!bending)
-          band<false, false, true>(r, normals, scale, offset, consume, fields, qa, qb, s);
+          band<false, false, true>(r, normals, scale, offset, consume, qa, qb, s);
         else if (coupling)
-          band<true, true, true>(r, normals, scale, offset, consume, fields, qa, qb, s);
+          band<true, true, true>(r, normals, scale, offset, consume, qa, qb, s);
         else
-          band<true, false, true>(r, normals, scale, offset, consume, fields, qa, qb, s);
+          band<true, false, true>(r, normals, scale, offset, consume, qa, qb, s);
       } else {
         if (!bending)
-          band<false, false, false>(r, normals, scale, offset, consume, fields, qa, qb, s);
+          band<false, false, false>(r, normals, scale, offset, consume, qa, qb, s);
         else if (coupling)
-          band<true, true, false>(r, normals, scale, offset, consume, fields, qa, qb, s);
+          band<true, true, false>(r, normals, scale, offset, consume, qa, qb, s);
         else
-          band<true, false, false>(r, normals, scale, offset, consume, fields, qa, qb, s);
+          band<true, false, false>(r, normals, scale, offset, consume, qa, qb, s);
       }
     }
   }

@@ -100,8 +100,7 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
 }
 
 void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
-                                      const CosseratEnergy::RowConsumer& consume,
-                                      std::span<const CosseratEnergy::RowField> fields) {
+                                      const CosseratEnergy::RowConsumer& consume) {
   assert(fuses_rows());
   const Block& b = *block_;
   const double load_scale = rest_inverse_density() / h1h2_;
@@ -118,7 +117,7 @@ void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
         z[i] += acceleration.z;
       }
     consume(l, x, y, z);
-  }, fields);
+  });
 }
 
 double Dynamics::elastic_energy(const Field<Vec3>& r) {

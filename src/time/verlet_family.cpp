@@ -72,22 +72,15 @@ void VerletFamily::centred_step(long step) {
                            ? context_.edge_check
                            : nullptr;
     if (edges != nullptr) edges->begin_walk();
-    // r comes from the kernel's cache; r⁻ and r⁺ from memory, fetched ahead by the kernel.
-    const CosseratEnergy::RowField fields[] = {{&previous_positions_, false},
-                                               {&next_positions_, true}};
-    dynamics.free_acceleration_rows(
-        positions_, step,
-        [&](int l, double* x, double* y, double* z) {
-          const Vec3* r = &positions_(b.k0, l);
-          const Vec3* rp = &previous_positions_(b.k0, l);
-          Vec3* next = &next_positions_(b.k0, l);
+    dynamics.free_acceleration_rows(positions_, step, [&](int l, double* x, double* y, double* z) {
+      const Vec3* r = &positions_(b.k0, l);
+      const Vec3* rp = &previous_positions_(b.k0, l);
+      Vec3* next = &next_positions_(b.k0, l);
 #pragma omp simd
-          for (int i = 0; i < b.owned_k(); ++i)
-            next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
-          constraints.hold_row(next_positions_, l, context_.end_time);
-          if (edges != nullptr) edges->walk_row(l, positions_, next_positions_);
-        },
-        fields);
+      for (int i = 0; i < b.owned_k(); ++i) next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
+      constraints.hold_row(next_positions_, l, context_.end_time);
+      if (edges != nullptr) edges->walk_row(l, positions_, next_positions_);
+    });
     return;
   }
   Field<Vec3>* n_field = normals();

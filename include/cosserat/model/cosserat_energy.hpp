@@ -4,7 +4,6 @@
 
 #include <array>
 #include <functional>
-#include <span>
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
@@ -54,15 +53,9 @@ class CosseratEnergy {
   // (column b.k0 first), handed over while it is still in cache instead of written to a field;
   // the consumer may change them. Called from the thread that owns the row, once per owned row,
   // in ascending order within a thread.
-  // `fields` are those the consumer reads (or writes) at row l: the kernel fetches their row l
-  // from memory while it computes the gradients that finish it (docs/kernel.md).
   using RowConsumer = std::function<void(int l, double* x, double* y, double* z)>;
-  struct RowField {
-    const Field<Vec3>* field;
-    bool write;
-  };
   void internal_force_rows(const Field<Vec3>& positions, double scale, const Vec3& offset,
-                           const RowConsumer& consume, std::span<const RowField> fields = {});
+                           const RowConsumer& consume);
 
   // This block's share of E (J): the energies of the nodes it owns, summed row by row in order.
   // Reads the ghosts one node beyond the owned range.
@@ -85,16 +78,6 @@ class CosseratEnergy {
     int width = 0;
     std::vector<double> positions, gradient, force, normal;
     int position_row[3] = {-1, -1, -1};  // the grid row each positions slot holds
-    // Rows of fields read (or written) soon after this row's gradients: the next row of
-    // positions, and the consumer's fields at the row they finish. interior_row asks for the
-    // cache lines of each block's columns of them, so that they come from memory while it
-    // computes instead of when they are swept, a row at a time (docs/kernel.md).
-    struct Ahead {
-      const char* first;  // the row's column gk0
-      long bytes;         // to the end of the columns used
-      bool write;
-    };
-    std::vector<Ahead> ahead;
     void resize(int columns);
   };
 
@@ -104,11 +87,9 @@ class CosseratEnergy {
   void border_node(const Field<Vec3>& positions, int k, int l, int k_base, RowScratch& s) const;
   template <bool Bending, bool Coupling, bool Normal>
   void band(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
-            const Vec3& offset, const RowConsumer& consume, std::span<const RowField> fields,
-            int qa, int qb, RowScratch& s) const;
+            const Vec3& offset, const RowConsumer& consume, int qa, int qb, RowScratch& s) const;
   void all_bands(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
-                 const Vec3& offset, const RowConsumer& consume,
-                 std::span<const RowField> fields);
+                 const Vec3& offset, const RowConsumer& consume);
 
   const Block* block_;
   double h1_, h2_;

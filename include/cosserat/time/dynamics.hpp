@@ -3,7 +3,6 @@
 // the external terms the scene declares (DESIGN.md principle 3).
 
 #include <optional>
-#include <span>
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
@@ -42,11 +41,9 @@ class Dynamics {
   }
   // free_acceleration's `a`, without the field: each finished row goes to `consume` (see
   // CosseratEnergy::internal_force_rows) while it is in cache, so that a scheme's update reads
-  // it there. The same bits as free_acceleration's; with fuses_rows() only. `fields`: those
-  // `consume` reads or writes at its row (CosseratEnergy::internal_force_rows).
+  // it there. The same bits as free_acceleration's; with fuses_rows() only.
   void free_acceleration_rows(const Field<Vec3>& r, long step,
-                              const CosseratEnergy::RowConsumer& consume,
-                              std::span<const CosseratEnergy::RowField> fields = {});
+                              const CosseratEnergy::RowConsumer& consume);
 
   // The internal force's share of the acceleration, f_int/μ, into `a`: independent of S
   // (MODEL.md §3), so a function of the positions alone. The semi-implicit baseline
