@@ -75,8 +75,10 @@ void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
   const Vec3 G_s = (G_n - dot(G_n, c.n) * c.n) / c.sum_length;
   for (int i = 0; i < c.count; ++i) {
     const CornerNormals::Corner& q = c.corner[i];
-    energy::add_corner_gradient(q.normal, q.E, q.F, G_s, g[slot(q.ek, q.el)],
-                                g[slot(q.fk, q.fl)], g[slot(0, 0)]);
+    const energy::CornerGradient d = energy::corner_gradient(q.normal, q.E, q.F, G_s);
+    g[slot(q.ek, q.el)] += d.e;
+    g[slot(q.fk, q.fl)] += d.f;
+    g[slot(0, 0)] -= d.e + d.f;
   }
 }
 
@@ -84,13 +86,30 @@ bool any_nonzero(const Sym2& c) { return c[0] != 0.0 || c[1] != 0.0 || c[2] != 0
 
 }  // namespace
 
+energy::InteriorCoefficients energy::interior_coefficients(const Sym2& Phi, const Sym2& Psi,
+                                                           const Sym2& Theta, const Sym2& A,
+                                                           double h1, double h2) {
+  const double area = h1 * h2;
+  const Sym2 H{h1 * h1, h1 * h2, h2 * h2}, w{1.0, 2.0, 1.0};
+  InteriorCoefficients c;
+  for (int i = 0; i < 3; ++i) {
+    c.e[i] = 1.0 / (2.0 * H[i]);
+    c.half_A[i] = 0.5 * A[i];
+    c.nu_eps[i] = 2.0 * area * Phi[i] / H[i];
+    c.nu_beta[i] = -area * Theta[i] / (H[i] * H[i]);
+    c.mu_beta[i] = 2.0 * area * w[i] * Psi[i] / (H[i] * H[i]);
+    c.mu_eps[i] = -area * w[i] * Theta[i] / H[i];
+  }
+  return c;
+}
+
 CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest)
     : block_(&block),
       h1_(h1),
       h2_(h2),
       rest_(rest),
-      interior_{rest.Phi, rest.Psi, rest.Theta, rest.metric, h1 * h2, 1.0 / h1, 1.0 / h2,
-                1.0 / (h1 * h1), 1.0 / (h2 * h2), 1.0 / (h1 * h2)},
+      interior_{energy::interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1,
+                                              h2)},
       terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)} {}
 
 // E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (MODEL.md §2.5): the sum
@@ -259,13 +278,18 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
       const energy::InteriorGradient g = energy::interior_gradient<Bending, Coupling, Normal>(
           co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c), at(below, c),
           at(above, c + 1), n);
-      const Vec3* slot[kInteriorSlots] = {&g.centre, &g.right, &g.left,
-                                          &g.up,     &g.down,  &g.up_right};
-      for (int q = 0; q < kInteriorSlots; ++q) {
-        G[(3 * q + 0) * w + c] = slot[q]->x;
-        G[(3 * q + 1) * w + c] = slot[q]->y;
-        G[(3 * q + 2) * w + c] = slot[q]->z;
-      }
+      // By value, not through pointers to g: a lane's g then never needs an address.
+      auto store = [&](int q, const Vec3& v) {
+        G[(3 * q + 0) * w + c] = v.x;
+        G[(3 * q + 1) * w + c] = v.y;
+        G[(3 * q + 2) * w + c] = v.z;
+      };
+      store(0, g.centre);
+      store(1, g.right);
+      store(2, g.left);
+      store(3, g.up);
+      store(4, g.down);
+      store(5, g.up_right);
       if (Normal) {
         N[c] = n.x;
         N[w + c] = n.y;

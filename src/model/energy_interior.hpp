@@ -32,36 +32,34 @@ struct Corner {
   return {c * (1.0 / length), length};
 }
 
-// Back through a corner's c/|c| and c = E × F: adds ∂/∂r of G_s · (c/|c|) to the slots of its
-// edges' far nodes (e, f) and of p.
-[[gnu::always_inline]] inline void add_corner_gradient(const Corner& q, const Vec3& E,
-                                                       const Vec3& F, const Vec3& G_s, Vec3& e,
-                                                       Vec3& f, Vec3& centre) {
+// Back through a corner's c/|c| and c = E × F: ∂/∂r of G_s · (c/|c|) at its edges' far nodes;
+// at p it is minus their sum.
+struct CornerGradient {
+  Vec3 e, f;
+};
+
+[[gnu::always_inline]] inline CornerGradient corner_gradient(const Corner& q, const Vec3& E,
+                                                             const Vec3& F, const Vec3& G_s) {
   const Vec3 G_c = (G_s - dot(G_s, q.unit) * q.unit) * (1.0 / q.length);
   // G_c · (δE × F) = δE · (F × G_c), G_c · (E × δF) = δF · (G_c × E).
-  const Vec3 G_E = cross(F, G_c), G_F = cross(G_c, E);
-  e += G_E;
-  f += G_F;
-  centre -= G_E + G_F;
+  return {cross(F, G_c), cross(G_c, E)};
 }
 
 // Positions of p = (k, l), its neighbours and (k+1, l+1); the unit normal n of p comes back in
-// `normal` when the bending terms or the caller (Normal: the fluid term reads it) need it.
+// `normal` when the bending terms or the caller (Normal: the fluid term reads it) need it. The
+// symbols are InteriorCoefficients'.
 template <bool Bending, bool Coupling, bool Normal>
 [[gnu::always_inline]] inline InteriorGradient interior_gradient(
     const InteriorCoefficients& c, const Vec3& r, const Vec3& r_right, const Vec3& r_left,
     const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal) {
-  InteriorGradient g;
-  // §2.1 rule 1: a_α = D⁺_α r.
+  // ∂E_p/∂r at the five slots other than p, built up term by term.
+  Vec3 g_right, g_left, g_up, g_down, g_up_right;
+  // §2.1 rule 1: a_α = D_α / h_α, so ε_αβ = ½ (a_α · a_β − A_αβ) = e_αβ D_α · D_β − ½A_αβ.
   const Vec3 right = r_right - r, up = r_up - r;
-  const Vec3 a1 = right * c.inv_h1, a2 = up * c.inv_h2;
-  const double eps11 = 0.5 * (dot(a1, a1) - c.A[0]);
-  const double eps12 = 0.5 * (dot(a1, a2) - c.A[1]);
-  const double eps22 = 0.5 * (dot(a2, a2) - c.A[2]);
-
-  // ∂E_p/∂ε_αβ (the (1,2) terms count twice in Σ_αβ).
-  double N11 = 2.0 * c.Phi[0] * eps11, N22 = 2.0 * c.Phi[2] * eps22;
-  double N12 = 2.0 * (2.0 * c.Phi[1] * eps12);
+  const double eps11 = c.e[0] * dot(right, right) - c.half_A[0];
+  const double eps12 = c.e[1] * dot(right, up) - c.half_A[1];
+  const double eps22 = c.e[2] * dot(up, up) - c.half_A[2];
+  double nu11 = c.nu_eps[0] * eps11, nu12 = c.nu_eps[1] * eps12, nu22 = c.nu_eps[2] * eps22;
 
   if (Bending || Normal) {
     // §2.1 rule 2: n = s/|s|, s the sum of the four corner triangles' unit normals.
@@ -74,58 +72,52 @@ template <bool Bending, bool Coupling, bool Normal>
     normal = n;
 
     if (Bending) {
-      // §2.1 rule 3: r_,αα = D_αα r, r_,12 = X₊₊; κ_αβ = −n · r_,αβ.
-      const Vec3 r11 = (right + left) * c.inv_h11;
-      const Vec3 r22 = (up + down) * c.inv_h22;
-      const Vec3 r12 = ((r_up_right - r_right) - up) * c.inv_h12;
-      const double k11 = -dot(n, r11), k12 = -dot(n, r12), k22 = -dot(n, r22);
-
-      double M11 = 2.0 * c.Psi[0] * k11, M22 = 2.0 * c.Psi[2] * k22;
-      double M12 = 2.0 * (2.0 * c.Psi[1] * k12);
+      // §2.1 rule 3: H r_,αα = D_α + D_−α, h₁h₂ r_,12 = X₊₊ before its division; κ = −β/H.
+      const Vec3 d11 = right + left, d22 = up + down, d12 = (r_up_right - r_right) - up;
+      const double beta11 = dot(n, d11), beta12 = dot(n, d12), beta22 = dot(n, d22);
+      double mu11 = c.mu_beta[0] * beta11, mu12 = c.mu_beta[1] * beta12,
+             mu22 = c.mu_beta[2] * beta22;
       if (Coupling) {
-        N11 += c.Theta[0] * k11;
-        N22 += c.Theta[2] * k22;
-        N12 += 2.0 * (c.Theta[1] * k12);
-        M11 += c.Theta[0] * eps11;
-        M22 += c.Theta[2] * eps22;
-        M12 += 2.0 * (c.Theta[1] * eps12);
+        nu11 += c.nu_beta[0] * beta11;
+        nu12 += c.nu_beta[1] * beta12;
+        nu22 += c.nu_beta[2] * beta22;
+        mu11 += c.mu_eps[0] * eps11;
+        mu12 += c.mu_eps[1] * eps12;
+        mu22 += c.mu_eps[2] * eps22;
       }
-      M11 *= c.area;
-      M22 *= c.area;
-      M12 *= c.area;
-
-      // κ_αβ = −n · r_,αβ: ∂/∂r_,αβ = −M n, ∂/∂n = −Σ M r_,αβ.
-      const Vec3 G_X11 = (-M11 * c.inv_h11) * n;
-      const Vec3 G_X22 = (-M22 * c.inv_h22) * n;
-      const Vec3 G_X12 = (-M12 * c.inv_h12) * n;
-      g.right = G_X11 - G_X12;
-      g.left = G_X11;
-      g.up = G_X22 - G_X12;
-      g.down = G_X22;
-      g.up_right = G_X12;
-      g.centre = G_X12 - 2.0 * (G_X11 + G_X22);
-      const Vec3 G_n = -((M11 * r11 + M22 * r22) + M12 * r12);
+      // β_i = n · Δ_i: ∂/∂Δ_i = μ_i n, ∂/∂n = Σ μ_i Δ_i.
+      const Vec3 G_X11 = mu11 * n, G_X12 = mu12 * n, G_X22 = mu22 * n;
+      g_right = G_X11 - G_X12;
+      g_left = G_X11;
+      g_up = G_X22 - G_X12;
+      g_down = G_X22;
+      g_up_right = G_X12;
+      const Vec3 G_n = (mu11 * d11 + mu22 * d22) + mu12 * d12;
 
       // Back through n = s/|s|, then through each corner's unit normal.
       const Vec3 G_s = (G_n - dot(G_n, n) * n) * (1.0 / s_length);
-      add_corner_gradient(q0, right, up, G_s, g.right, g.up, g.centre);
-      add_corner_gradient(q1, up, left, G_s, g.up, g.left, g.centre);
-      add_corner_gradient(q2, left, down, G_s, g.left, g.down, g.centre);
-      add_corner_gradient(q3, down, right, G_s, g.down, g.right, g.centre);
+      const CornerGradient g0 = corner_gradient(q0, right, up, G_s),
+                           g1 = corner_gradient(q1, up, left, G_s),
+                           g2 = corner_gradient(q2, left, down, G_s),
+                           g3 = corner_gradient(q3, down, right, G_s);
+      g_right += g0.e;
+      g_up += g0.f;
+      g_up += g1.e;
+      g_left += g1.f;
+      g_left += g2.e;
+      g_down += g2.f;
+      g_down += g3.e;
+      g_right += g3.f;
     }
   }
 
-  // ε_αβ = ½ (a_α · a_β − A_αβ): ∂/∂a₁ = N¹¹ a₁ + ½ N¹² a₂, ∂/∂a₂ = N²² a₂ + ½ N¹² a₁, and
-  // a_α = D⁺_α r.
-  N11 *= c.area;
-  N22 *= c.area;
-  N12 *= c.area;
-  const Vec3 G_a1 = (N11 * a1 + (0.5 * N12) * a2) * c.inv_h1;
-  const Vec3 G_a2 = (N22 * a2 + (0.5 * N12) * a1) * c.inv_h2;
-  g.right += G_a1;
-  g.up += G_a2;
-  g.centre -= G_a1 + G_a2;
-  return g;
+  // ∂/∂D₁ = ν₁₁ D₁ + ν₁₂ D₂, ∂/∂D₂ = ν₂₂ D₂ + ν₁₂ D₁.
+  g_right += nu11 * right + nu12 * up;
+  g_up += nu22 * up + nu12 * right;
+  // E_p moves with nothing but differences of positions, so its gradient sums to zero: p's slot
+  // is minus the others (and the forces it makes conserve momentum to round-off).
+  const Vec3 g_centre = -((((g_right + g_left) + g_up) + g_down) + g_up_right);
+  return {g_centre, g_right, g_left, g_up, g_down, g_up_right};
 }
 
 }  // namespace cosserat::energy

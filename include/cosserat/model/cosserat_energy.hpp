@@ -14,16 +14,26 @@ namespace cosserat {
 
 namespace energy {
 
-// The constants of the interior gradient: the moduli of §1 at rest, the rest metric and the
-// finite-difference factors, each reciprocal taken once (Vec3's division multiplies by the
-// reciprocal too, so r/h and r·(1/h) are the same bits).
+// The constants of the interior gradient (MODEL.md §2.5), with every grid factor folded in so
+// that a node multiplies as little as it can. With i = 11, 12, 22, H_i = h₁², h₁h₂, h₂², the
+// weight w_i = 1, 2, 1 of the (1, 2) terms in Σ_αβ, the forward edges D₁ = r(k+1, l) − r and
+// D₂ = r(k, l+1) − r, and β_i = n · Δ_i with Δ_i = H_i r_,αβ (the stencil's differences before
+// its division):
+//   ε_i = e_i (D_α · D_β) − ½A_i,   κ_i = −β_i / H_i,
+//   ν_i = area (2Φ_i ε_i + Θ_i κ_i) / H_i      (∂E_p/∂(D_α · D_β), times 2 for i = 11, 22),
+//   μ_i = ∂E_p/∂β_i = −area w_i (2Ψ_i κ_i + Θ_i ε_i) / H_i.
+// Built once from the moduli by interior_coefficients.
 struct InteriorCoefficients {
-  Sym2 Phi, Psi, Theta, A;
-  double area;                 // h₁h₂
-  double inv_h1, inv_h2;       // 1/h_α
-  double inv_h11, inv_h22;     // 1/h_α²
-  double inv_h12;              // 1/(h₁h₂)
+  Sym2 e;          // 1/(2H_i)
+  Sym2 half_A;     // ½A_i
+  Sym2 nu_eps;     // ν_i = nu_eps_i ε_i + nu_beta_i β_i
+  Sym2 nu_beta;
+  Sym2 mu_beta;    // μ_i = mu_beta_i β_i + mu_eps_i ε_i
+  Sym2 mu_eps;
 };
+
+InteriorCoefficients interior_coefficients(const Sym2& Phi, const Sym2& Psi, const Sym2& Theta,
+                                           const Sym2& A, double h1, double h2);
 
 // The terms a material switches off: ξ = 0 and φ = 0 leave no curvature term at all (Ψ = Θ =
 // 0), φ = 0 no coupling (Θ = 0); a kernel built without them skips their arithmetic. Skipping
