@@ -278,7 +278,8 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
       const energy::InteriorGradient g = energy::interior_gradient<Bending, Coupling, Normal>(
           co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c), at(below, c),
           at(above, c + 1), n);
-      // By value, not through pointers to g: a lane's g then never needs an address.
+      // Slot by slot: an array of pointers into g would give each lane's g an address, and
+      // the loop would not vectorise.
       auto store = [&](int q, const Vec3& v) {
         G[(3 * q + 0) * w + c] = v.x;
         G[(3 * q + 1) * w + c] = v.y;
