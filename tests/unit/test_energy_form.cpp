@@ -193,6 +193,31 @@ TEST(EnergyForm, RigidMotionHasNoEnergyAndNoForce) {
   EXPECT_LT(std::abs(sheet.total()), 1e-20 * zeta * sheet.scene.size1 * sheet.scene.size2);
 }
 
+// E depends on the positions only through their differences and is unchanged by a rotation, so
+// the internal forces of any deformed sheet carry no net force and no net torque: momentum and
+// angular momentum are conserved. The sheet is wider than two lane blocks, so interior nodes
+// (whose own slot is minus the other five) and the border ring both take part.
+TEST(EnergyForm, InternalForcesHaveNoNetForceAndNoNetTorque) {
+  Scene scene = coupled_sheet();
+  scene.m = 21;
+  scene.n = 9;
+  Sheet sheet(scene);
+  Field<Vec3> force(sheet.block);
+  sheet.energy.internal_force(sheet.r, force);
+  Vec3 net, torque;
+  double magnitude = 0.0, lever = 0.0;
+  for (int l = 0; l < scene.n; ++l)
+    for (int k = 0; k < scene.m; ++k) {
+      net += force(k, l);
+      torque += cross(sheet.r(k, l), force(k, l));
+      magnitude += norm(force(k, l));
+      lever = std::max(lever, norm(sheet.r(k, l)));
+    }
+  ASSERT_GT(magnitude, 1.0);  // the sheet is well away from rest
+  EXPECT_LT(norm(net), 1e-13 * magnitude);
+  EXPECT_LT(norm(torque), 1e-13 * magnitude * lever);
+}
+
 // Kinetic + elastic + gravitational energy of a damped sheet falling from a held corner, after
 // every step: the largest rise from one step to the next, and what damping took in all.
 double largest_energy_rise(double dt, double* total_drop) {
