@@ -84,14 +84,12 @@ void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
 
 bool any_nonzero(const Sym2& c) { return c[0] != 0.0 || c[1] != 0.0 || c[2] != 0.0; }
 
-}  // namespace
-
-energy::InteriorCoefficients energy::interior_coefficients(const Sym2& Phi, const Sym2& Psi,
-                                                           const Sym2& Theta, const Sym2& A,
-                                                           double h1, double h2) {
+energy::InteriorCoefficients interior_coefficients(const Sym2& Phi, const Sym2& Psi,
+                                                   const Sym2& Theta, const Sym2& A, double h1,
+                                                   double h2) {
   const double area = h1 * h2;
   const Sym2 H{h1 * h1, h1 * h2, h2 * h2}, w{1.0, 2.0, 1.0};
-  InteriorCoefficients c;
+  energy::InteriorCoefficients c;
   for (int i = 0; i < 3; ++i) {
     c.e[i] = 1.0 / (2.0 * H[i]);
     c.half_A[i] = 0.5 * A[i];
@@ -103,13 +101,14 @@ energy::InteriorCoefficients energy::interior_coefficients(const Sym2& Phi, cons
   return c;
 }
 
+}  // namespace
+
 CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest)
     : block_(&block),
       h1_(h1),
       h2_(h2),
       rest_(rest),
-      interior_{energy::interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1,
-                                              h2)},
+      interior_{interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1, h2)},
       terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)} {}
 
 // E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (MODEL.md §2.5): the sum

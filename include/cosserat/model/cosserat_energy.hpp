@@ -22,7 +22,7 @@ namespace energy {
 //   ε_i = e_i (D_α · D_β) − ½A_i,   κ_i = −β_i / H_i,
 //   ν_i = area (2Φ_i ε_i + Θ_i κ_i) / H_i      (∂E_p/∂(D_α · D_β), times 2 for i = 11, 22),
 //   μ_i = ∂E_p/∂β_i = −area w_i (2Ψ_i κ_i + Θ_i ε_i) / H_i.
-// Built once from the moduli by interior_coefficients.
+// Built once from the moduli by interior_coefficients in cosserat_energy.cpp.
 struct InteriorCoefficients {
   Sym2 e;          // 1/(2H_i)
   Sym2 half_A;     // ½A_i
@@ -31,9 +31,6 @@ struct InteriorCoefficients {
   Sym2 mu_beta;    // μ_i = mu_beta_i β_i + mu_eps_i ε_i
   Sym2 mu_eps;
 };
-
-InteriorCoefficients interior_coefficients(const Sym2& Phi, const Sym2& Psi, const Sym2& Theta,
-                                           const Sym2& A, double h1, double h2);
 
 // The terms a material switches off: ξ = 0 and φ = 0 leave no curvature term at all (Ψ = Θ =
 // 0), φ = 0 no coupling (Θ = 0); a kernel built without them skips their arithmetic. Skipping
