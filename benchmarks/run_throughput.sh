@@ -1,15 +1,17 @@
 #!/usr/bin/env bash
 # Node-steps per second of one Verlet step (bench_step) on 256², 1024², 2048², 4096² with 1 and 2
-# threads, into benchmarks/results/throughput-<host>-<date>.{json,md} with the machine,
-# compiler, git revision, ranks x threads and date beside every number, and against the force
-# kernel's targets (docs/kernel.md: 4 × 10⁷ node-steps/s on one core, 1.9 times that on two).
+# threads, into benchmarks/results/NAME-<host>-<date>.{json,md} (NAME "throughput" unless
+# RESULT_NAME says otherwise) with the machine, compiler, git revision, ranks x threads and date
+# beside every number, and against the force kernel's targets (docs/kernel.md: 4 × 10⁷
+# node-steps/s on one core, 1.9 times that on two).
 # REPETITIONS runs of each case (default 3), interleaved in random order so that a VM's drift
 # falls on every case alike; the median of each is reported.
 #   benchmarks/run_throughput.sh [extra Google Benchmark flags]
 #   REPETITIONS=7 benchmarks/run_throughput.sh
+#   RESULT_NAME=throughput-balance benchmarks/run_throughput.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source benchmarks/context.sh throughput benchmark bench_step
+source benchmarks/context.sh "${RESULT_NAME:-throughput}" benchmark bench_step
 
 run_step_benchmark build/benchmark/benchmarks/bench_step --benchmark_filter='verlet_step/' \
   --benchmark_repetitions="${REPETITIONS:-3}" --benchmark_enable_random_interleaving=true "$@"

@@ -5,11 +5,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
@@ -113,6 +115,59 @@ ThreadPlacement place_threads(MPI_Comm comm, long rows, std::optional<int> reque
   placement.node_threads = figures[1];
   placement.node_cores = figures[2];
   return placement;
+}
+
+const std::vector<long>& RowBalance::split(long rows, int threads) {
+  const auto bands = static_cast<std::size_t>(std::max(threads, 1));
+  if (first_row_.size() != bands + 1 || first_row_.back() != rows) {
+    first_row_.resize(bands + 1);
+    for (std::size_t t = 0; t <= bands; ++t)
+      first_row_[t] = rows * static_cast<long>(t) / static_cast<long>(bands);
+    seconds_.assign(bands, 0.0);
+    row_cost_.assign(bands, 0.0);
+  }
+  return first_row_;
+}
+
+void RowBalance::assign(std::vector<long> first_row) {
+  first_row_ = std::move(first_row);
+  const std::size_t bands = first_row_.empty() ? 0 : first_row_.size() - 1;
+  seconds_.assign(bands, 0.0);
+  row_cost_.assign(bands, 0.0);
+}
+
+void RowBalance::rebalance() {
+  const std::size_t bands = seconds_.size();
+  if (bands < 2) return;
+  // One step's time carries the noise of the machine (a timer tick, another process), so a
+  // thread's cost a row is smoothed over about ten steps and a single step moves it by at most
+  // a factor of two.
+  constexpr double kWeight = 0.1;
+  for (std::size_t t = 0; t < bands; ++t) {
+    const long rows = first_row_[t + 1] - first_row_[t];
+    const double seconds = std::exchange(seconds_[t], 0.0);  // each measurement counts once
+    if (rows <= 0 || !(seconds > 0.0)) continue;
+    const double cost = seconds / static_cast<double>(rows);
+    double& smoothed = row_cost_[t];
+    if (smoothed > 0.0)
+      smoothed += kWeight * (std::clamp(cost, 0.5 * smoothed, 2.0 * smoothed) - smoothed);
+    else
+      smoothed = cost;
+  }
+  double total_rate = 0.0;
+  for (const double cost : row_cost_) {
+    if (!(cost > 0.0)) return;  // a thread not yet measured: keep the split
+    total_rate += 1.0 / cost;
+  }
+  const long rows = first_row_.back();
+  if (rows < static_cast<long>(bands)) return;
+  double rate = 0.0;
+  for (std::size_t t = 1; t < bands; ++t) {
+    rate += 1.0 / row_cost_[t - 1];
+    const long row = std::lround(static_cast<double>(rows) * rate / total_rate);
+    // Every band keeps at least one row.
+    first_row_[t] = std::clamp(row, first_row_[t - 1] + 1, rows - static_cast<long>(bands - t));
+  }
 }
 
 }  // namespace cosserat

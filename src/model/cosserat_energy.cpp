@@ -440,17 +440,25 @@ void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, doubl
   // Columns from gk0 − 1 to gk1, and the last interior block's lanes past it.
   const int columns = (gk1 - gk0 + 2) + 2 * kLanes;
   const bool bending = terms_.bending, coupling = terms_.coupling;
-#pragma omp parallel
+  const int planned = omp_get_max_threads();
+  if (static_cast<int>(scratch_.size()) < planned)
+    scratch_.resize(static_cast<std::size_t>(planned));
+  const std::vector<long>& first_row = balance_.split(b.owned_l(), planned);
+#pragma omp parallel num_threads(planned)
   {
-    const int threads = omp_get_num_threads(), t = omp_get_thread_num();
-#pragma omp single
-    if (static_cast<int>(scratch_.size()) < threads) scratch_.resize(static_cast<std::size_t>(threads));
+    const int t = omp_get_thread_num();
+    const double start = omp_get_wtime();
     // Each thread sizes, and so first touches, its own buffers.
     RowScratch& s = scratch_[static_cast<std::size_t>(t)];
     s.resize(columns);
-    const long rows = b.owned_l();
-    const int qa = b.l0 + static_cast<int>(rows * t / threads);
-    const int qb = b.l0 + static_cast<int>(rows * (t + 1) / threads);
+    // The runtime may give fewer threads than asked for (OMP_DYNAMIC): then an even split.
+    const long threads = omp_get_num_threads(), rows = b.owned_l();
+    const bool planned_split = threads == planned;
+    auto band_start = [&](long i) {
+      return b.l0 + static_cast<int>(planned_split ? first_row[static_cast<std::size_t>(i)]
+                                                   : rows * i / threads);
+    };
+    const int qa = band_start(t), qb = band_start(t + 1);
     if (qa < qb) {
       if (normals != nullptr) {
         if (!bending)
@@ -468,7 +476,9 @@ void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, doubl
           band<true, false, false>(r, normals, scale, offset, consume, qa, qb, s);
       }
     }
+    if (planned_split) balance_.record(t, omp_get_wtime() - start);
   }
+  balance_.rebalance();
 }
 
 double CosseratEnergy::block_energy(const Field<Vec3>& r) const {

@@ -104,8 +104,6 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_ti
   const Field<Vec3>& r = scheme_->positions();
   const double limit2 = max_move_ * max_move_;
   const long none = std::numeric_limits<long>::max();
-  std::vector<long> first_bad(static_cast<std::size_t>(b.owned_l()), none);
-  std::vector<char> not_finite(static_cast<std::size_t>(b.owned_l()), 0);
   // Written so that a NaN also fails.
   auto too_far = [&](const Vec3& move, int k, int l) {
     const Vec3 neighbour = next(k, l) - r(k, l);
@@ -122,28 +120,21 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_ti
   // A node fails only if one of its edges changed by more than the limit, or its position is
   // not finite (and then every edge of it fails the edge test too): only a row with such an
   // edge, which the edge test finds without an early exit (in the Verlet step while the rows
-  // are still in cache), is scanned for its first failing node.
+  // are still in cache), is scanned for its first failing node. Most steps flag none, and a
+  // flagged row holds a failing node or neighbours one, so the scan is serial: threads started
+  // for it would cost a step more than it does.
   const std::vector<char>& may_fail = edge_check_.flag_rows(r, next);
-#pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l) {
-    const auto row = static_cast<std::size_t>(l - b.l0);
-    if (!may_fail[row]) continue;
-    for (int k = b.k0; k < b.k1; ++k) {
-      if (fails(k, l)) {
-        first_bad[row] = static_cast<long>(l) * b.m + k;
-        not_finite[row] = !is_finite(next(k, l));
-        break;
-      }
-    }
-  }
   long local = none;
   bool local_not_finite = false;
-  for (std::size_t row = 0; row < first_bad.size(); ++row)
-    if (first_bad[row] != none) {
-      local = first_bad[row];
-      local_not_finite = not_finite[row];
-      break;
-    }
+  for (int l = b.l0; l < b.l1 && local == none; ++l) {
+    if (!may_fail[static_cast<std::size_t>(l - b.l0)]) continue;
+    for (int k = b.k0; k < b.k1; ++k)
+      if (fails(k, l)) {
+        local = static_cast<long>(l) * b.m + k;
+        local_not_finite = !is_finite(next(k, l));
+        break;
+      }
+  }
   long global = local;
   MPI_Allreduce(&local, &global, 1, MPI_LONG, MPI_MIN, b.comm);
   if (global == none) return std::nullopt;

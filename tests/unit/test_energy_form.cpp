@@ -2,6 +2,7 @@
 // energy is that of the §2.1 strains, and a damped run never gains energy.
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -38,6 +39,55 @@ Scene coupled_sheet() {
   s.material.xi = {0.3, 0.2, 0.4};
   s.material.phi = {0.05, 0.02, 0.03};
   return s;
+}
+
+// The threads' bands of rows follow their speeds (RowBalance), so the forces must not depend on
+// where a band ends: on every split of the owned rows among three threads, the forces and
+// normals are bitwise those of one thread, on the whole grid and on a block of it whose low rows
+// are another rank's.
+TEST(EnergyForm, ForcesAreBitwiseTheSameOnEverySplitOfTheRows) {
+  const Scene scene = [] {
+    Scene s = coupled_sheet();
+    s.m = 19;  // rows longer than a lane block, with a remainder
+    s.n = 9;
+    return s;
+  }();
+  const RestState rest = flat_rest_state(scene.material, scene.u, scene.v);
+  Block whole = Block::whole(scene.m, scene.n, MPI_COMM_SELF);
+  Block part = whole;
+  part.l0 = 2;
+  const int threads_before = omp_get_max_threads();
+  for (const Block* block : {&whole, &part}) {
+    const Block& b = *block;
+    Field<Vec3> r(b);
+    for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
+      for (int k = 0; k < b.m; ++k) r(k, l) = testing::deformed(scene, k, l);
+    Field<Vec3> force_one(b), normals_one(b);
+    omp_set_num_threads(1);
+    CosseratEnergy one(b, scene.h1(), scene.h2(), rest);
+    one.internal_force(r, force_one, &normals_one);
+    omp_set_num_threads(3);
+    CosseratEnergy three(b, scene.h1(), scene.h2(), rest);
+    const long rows = b.owned_l();
+    int splits = 0;
+    for (long first = 1; first < rows - 1; ++first)
+      for (long second = first + 1; second < rows; ++second) {
+        three.row_balance().assign({0, first, second, rows});
+        Field<Vec3> force(b), normals(b);
+        three.internal_force(r, force, &normals);
+        ++splits;
+        for (int l = b.l0; l < b.l1; ++l)
+          for (int k = b.k0; k < b.k1; ++k)
+            for (int c = 0; c < 3; ++c) {
+              ASSERT_EQ(force(k, l)[c], force_one(k, l)[c])
+                  << "bands from rows 0, " << first << ", " << second << "; node " << k
+                  << ", " << l;
+              ASSERT_EQ(normals(k, l)[c], normals_one(k, l)[c]);
+            }
+      }
+    EXPECT_EQ(splits, (rows - 1) * (rows - 2) / 2);
+  }
+  omp_set_num_threads(threads_before);
 }
 
 // −∂E/∂r by central differences of E, against the kernel's force at every node and component.

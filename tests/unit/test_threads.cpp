@@ -58,5 +58,45 @@ TEST(Threads, DefaultIsTheRanksShareOfItsCoresAndAtMostItsRows) {
   EXPECT_EQ(default_threads(0, 0, 100), 1);     // no mask read: one thread, not zero
 }
 
+// Rows go to the threads in proportion to their measured rates: a thread twice as slow a row
+// ends with a third of them, and the bands stay contiguous, cover the rows and keep a row each.
+TEST(RowBalance, SplitsInProportionToTheThreadsRates) {
+  RowBalance balance;
+  const long rows = 300;
+  EXPECT_EQ(balance.split(rows, 2), (std::vector<long>{0, 150, 300}));  // even before measuring
+  for (int step = 0; step < 200; ++step) {
+    const std::vector<long>& first = balance.split(rows, 2);
+    balance.record(0, 2.0e-6 * static_cast<double>(first[1] - first[0]));
+    balance.record(1, 1.0e-6 * static_cast<double>(first[2] - first[1]));
+    balance.rebalance();
+  }
+  EXPECT_EQ(balance.split(rows, 2), (std::vector<long>{0, 100, 300}));
+  // A new row count or thread count starts again from the even split.
+  EXPECT_EQ(balance.split(rows, 3), (std::vector<long>{0, 100, 200, 300}));
+  EXPECT_EQ(balance.split(90, 3), (std::vector<long>{0, 30, 60, 90}));
+}
+
+TEST(RowBalance, OneSlowStepMovesFewRowsAndEveryBandKeepsARow) {
+  RowBalance balance;
+  const long rows = 1000;
+  auto step = [&](double slowdown_of_thread_0) {
+    const std::vector<long> first = balance.split(rows, 2);
+    balance.record(0, slowdown_of_thread_0 * 1e-6 * static_cast<double>(first[1] - first[0]));
+    balance.record(1, 1e-6 * static_cast<double>(first[2] - first[1]));
+    balance.rebalance();
+  };
+  step(1.0);
+  step(1.0);
+  EXPECT_EQ(balance.split(rows, 2)[1], 500);
+  step(100.0);  // a step in which thread 0 lost its core for a while
+  const long after = balance.split(rows, 2)[1];
+  EXPECT_LT(after, 500);
+  EXPECT_GT(after, 400);  // smoothed, and the step counted as at most twice as slow
+  for (int i = 0; i < 100; ++i) step(1.0);
+  EXPECT_NEAR(static_cast<double>(balance.split(rows, 2)[1]), 500.0, 2.0);
+  for (int i = 0; i < 200; ++i) step(1e6);  // a thread that hardly moves still keeps a row
+  EXPECT_EQ(balance.split(rows, 2), (std::vector<long>{0, 1, rows}));
+}
+
 }  // namespace
 }  // namespace cosserat

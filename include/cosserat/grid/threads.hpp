@@ -7,6 +7,7 @@
 #include <mpi.h>
 
 #include <optional>
+#include <vector>
 
 namespace cosserat {
 
@@ -35,5 +36,30 @@ struct ThreadPlacement {
 // ranks of this node (MPI_COMM_TYPE_SHARED) whose masks overlap it, and `rows`. Collective over
 // comm; every rank gets the same node figures.
 ThreadPlacement place_threads(MPI_Comm comm, long rows, std::optional<int> requested);
+
+// Splits a block's rows into one contiguous band per thread, in proportion to the rate at which
+// each thread went through its rows in the last steps. An even split assumes equal cores; where
+// they are not (a VM's cores run at speeds that differ by up to 10 % and change from one run to
+// the next, docs/kernel.md), every step waits at its closing barrier for the slower one. Where a
+// row goes changes no result: each node gets the same arithmetic whichever thread computes it.
+class RowBalance {
+ public:
+  // The first row of each thread's band, then the row count (threads + 1 entries): an even split
+  // on the first call and whenever rows or threads change. Every band gets a row if there are
+  // enough.
+  const std::vector<long>& split(long rows, int threads);
+  // The seconds thread t took for its band of the last split; each thread records its own.
+  void record(int t, double seconds) { seconds_[static_cast<std::size_t>(t)] = seconds; }
+  // Moves rows towards the threads that went faster; after every thread recorded.
+  void rebalance();
+  // Sets the bands, given as split returns them, until the next rebalance; for the tests that
+  // hold a kernel to the same bits on every split.
+  void assign(std::vector<long> first_row);
+
+ private:
+  std::vector<long> first_row_;
+  std::vector<double> seconds_;
+  std::vector<double> row_cost_;  // seconds a row, smoothed over the steps
+};
 
 }  // namespace cosserat

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/grid/threads.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "cosserat/grid/vec3.hpp"
 
@@ -78,6 +79,10 @@ class CosseratEnergy {
   double node_energy(const Field<Vec3>& positions, int k, int l, StencilGradient* gradient,
                      Vec3* normal = nullptr) const;
 
+  // The threads' bands of owned rows, which follow the threads' speeds. Public for the tests that
+  // hold the forces to the same bits on every split.
+  RowBalance& row_balance() { return balance_; }
+
  private:
   // One thread's row buffers (internal_force): three rows of positions and of forces, and one
   // row of gradients (nine slots) and normals, each component a contiguous array of `width`.
@@ -104,6 +109,7 @@ class CosseratEnergy {
   energy::InteriorCoefficients interior_;
   energy::Terms terms_;
   std::vector<RowScratch> scratch_;  // one per thread, sized by the first internal_force
+  RowBalance balance_;                // the threads' bands of owned rows
 };
 
 }  // namespace cosserat
