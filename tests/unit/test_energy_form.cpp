@@ -32,6 +32,14 @@ struct Sheet {
   double total() const { return energy.block_energy(r); }
 };
 
+// Sets r at a block's owned nodes and at its ghosts that lie in the grid, from position(k, l).
+template <class Position>
+void fill_with_ghosts(const Block& b, Field<Vec3>& r, Position position) {
+  for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
+    for (int k = std::max(b.k0 - b.ghost, 0); k < std::min(b.k1 + b.ghost, b.m); ++k)
+      r(k, l) = position(k, l);
+}
+
 Scene coupled_sheet() {
   // Unequal spacings and a coupling φ, so every term of E is exercised.
   Scene s = testing::flat_sheet(7, 6);
@@ -60,8 +68,7 @@ TEST(EnergyForm, ForcesAreBitwiseTheSameOnEverySplitOfTheRows) {
   for (const Block* block : {&whole, &part}) {
     const Block& b = *block;
     Field<Vec3> r(b);
-    for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
-      for (int k = 0; k < b.m; ++k) r(k, l) = testing::deformed(scene, k, l);
+    fill_with_ghosts(b, r, [&](int k, int l) { return testing::deformed(scene, k, l); });
     Field<Vec3> force_one(b), normals_one(b);
     omp_set_num_threads(1);
     CosseratEnergy one(b, scene.h1(), scene.h2(), rest);
@@ -144,16 +151,14 @@ TEST(EnergyForm, RowKernelAgreesWithTheNodeGradients) {
     for (const Block* block : {&whole, &part}) {
       const Block& b = *block;
       Field<Vec3> r(b), force(b), normals(b);
-      for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
-        for (int k = std::max(b.k0 - b.ghost, 0); k < std::min(b.k1 + b.ghost, b.m); ++k)
-          r(k, l) = testing::deformed(scene, k, l);
+      fill_with_ghosts(b, r, [&](int k, int l) { return testing::deformed(scene, k, l); });
       CosseratEnergy energy(b, scene.h1(), scene.h2(), rest);
       // A first call at rest positions: nothing of it may carry into the next.
       {
         Field<Vec3> rest_r(b);
-        for (int l = std::max(b.l0 - b.ghost, 0); l < std::min(b.l1 + b.ghost, b.n); ++l)
-          for (int k = std::max(b.k0 - b.ghost, 0); k < std::min(b.k1 + b.ghost, b.m); ++k)
-            rest_r(k, l) = (k * scene.h1()) * scene.u + (l * scene.h2()) * scene.v;
+        fill_with_ghosts(b, rest_r, [&](int k, int l) {
+          return (k * scene.h1()) * scene.u + (l * scene.h2()) * scene.v;
+        });
         energy.internal_force(rest_r, force);
       }
       for (const bool with_normals : {false, true}) {
