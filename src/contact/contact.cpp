@@ -18,6 +18,10 @@ namespace {
 // is left for the next step (CONTACT.md §2: a bounded number of repeats).
 constexpr int kMaxPasses = 4;
 
+// What touched_ holds for a node: the response moved it; a free body was among the solids.
+constexpr unsigned char kTouched = 1;
+constexpr unsigned char kByFreeBody = 2;
+
 // The spherical-linear interpolation from a to b at s in [0, 1], along the shorter arc.
 Quaternion slerp(Quaternion a, const Quaternion& b, double s) {
   double c = a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z;
@@ -110,6 +114,11 @@ Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double 
 }
 
 
+// The velocity of a solid's surface at world point x.
+Vec3 surface_velocity(const SolidState& body, const Vec3& x) {
+  return body.velocity + cross(body.angular_velocity, x - body.pose.position);
+}
+
 // The angle a frame turns through from orientation a to b.
 double turn_angle(const Quaternion& a, const Quaternion& b) {
   const double c = std::min(1.0, std::abs(a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z));
@@ -146,6 +155,9 @@ struct Contact::CellPush {
   std::array<double, 3> weights{};
   Vec3 move;
   Vec3 velocity_change;
+  Vec3 normal;   // world
+  Vec3 surface;  // the solid's surface velocity at the point
+  Vec3 velocity;  // the point's before the push
 };
 
 Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo,
@@ -157,6 +169,9 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
       spacing_(spacing),
       velocity_(block),
       touched_(block),
+      contact_normal_(block),
+      surface_velocity_(block),
+      normal_speed_(block),
       distance_(block),
       normal_(block) {
   for (const SolidSpec& spec : solids) {
@@ -212,10 +227,39 @@ void Contact::propose_free(Solid& s, double dt) const {
 // body's share is settled once all its contacts are known (apply_impulses).
 Vec3 Contact::velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
                               const Vec3& velocity) const {
-  const SolidState& body = s.proposed;
-  const Vec3 surface = body.velocity + cross(body.angular_velocity, point - body.pose.position);
-  return respond_velocity(velocity, surface, normal, s.spec.restitution, s.spec.friction) -
+  return respond_velocity(velocity, surface_velocity(s.proposed, point), normal,
+                          s.spec.restitution, s.spec.friction) -
          velocity;
+}
+
+void Contact::remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& surface,
+                       const Vec3& velocity) {
+  touched_(k, l) |= s.spec.motion == SolidMotion::free ? kTouched | kByFreeBody : kTouched;
+  contact_normal_(k, l) = n;
+  surface_velocity_(k, l) = surface;
+  const double approach = dot(velocity - surface, n);
+  normal_speed_(k, l) = approach < 0.0 ? -s.spec.restitution * approach : approach;
+}
+
+// docs/contact.md, "Velocities": the positions are what the next step starts from, so a
+// velocity that says more than the node moved is energy no position holds (nodes pushed back
+// by a box's side face every step kept the push as speed, 142 m/s while standing still). The
+// tangential part is what the node moved over the step (friction's change is in the move:
+// slip_correction); the normal part relative to the surface is the response's: e times the
+// approach, 0 for cloth that does not bounce, a leaving node's own, never the push that put
+// it back on the surface. A free body's nodes keep the response's velocity: their impulses
+// are what the body took (apply_impulses).
+void Contact::settle(const Field<Vec3>& current, const Field<Vec3>& next) {
+  const Block& b = *block_;
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      if (touched_(k, l) != kTouched) continue;
+      const Vec3 n = contact_normal_(k, l);
+      const Vec3 moved = (next(k, l) - current(k, l)) / dt_;
+      const double normal = dot(moved - surface_velocity_(k, l), n);
+      velocity_(k, l) = moved + (normal_speed_(k, l) - normal) * n;
+    }
 }
 
 // The step moved the node with its velocity before the response: friction's change of the
@@ -284,6 +328,10 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
           if (!t) continue;
           const Vec3 entry = start + *t * path;
           normal = g.closest(entry).normal;
+          // A node leaving the offset surface it rested on meets it at t = 0 when round-off
+          // puts its start a hair outside: it is not entering. Put back on the tangent plane,
+          // it stayed glued to a box's side face while its velocity grew without bound.
+          if (dot(path, normal) >= 0.0) continue;
           target = end - dot(end - entry, normal) * normal;
         }
         Vec3& r = next(k, l);
@@ -294,7 +342,7 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
         const Vec3 change = velocity_change(s, point, n, v_before);
         r = point + slip_correction(change, n);
         velocity_(k, l) = v_before + change;
-        touched_(k, l) = 1;
+        remember(s, k, l, n, surface_velocity(s.proposed, point), v_before);
         record(i, pass, 0, k, l, r_before, v_before, r, row);
       }
   }
@@ -311,9 +359,13 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const Block& b = *block_;
   const Solid& s = solids_[solid];
   const SolidGeometry& g = s.geometry;
-  const double offset = s.spec.thickness;
+  // Nodes rest on the offset surface; a triangle is pressed in only when it reaches half way
+  // to the solid, and goes back out to there (docs/contact.md, "Cells"). Testing it against
+  // the offset surface itself pushed every triangle resting on a curved solid out by its
+  // chord's sag, h²/8R, every step, which lifted its nodes off: they jittered, and without
+  // a normal force friction let them slide off a sphere.
+  const double offset = 0.5 * s.spec.thickness;
   const double radius = g.bounding_radius();
-  const double round_off = 1e-9 * (offset + spacing_);
   const bool convex = s.spec.shape.kind != ShapeKind::mesh;
   halo_->exchange(next);
   halo_->exchange(velocity_);
@@ -376,16 +428,13 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
             for (int j = 0; j < 3; ++j) reach = std::min(reach, dot(n, p[j] - p[v]));
             lower = std::max(lower, distance_(nodes[v][0], nodes[v][1]) + reach);
           }
-          if (lower >= offset - round_off) continue;
+          if (lower >= offset) continue;
         }
         const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
         if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
         const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
         const Closest c = g.closest(point);
-        // A cell lying on the offset surface, as node_pass leaves one under a flat face, is
-        // not pressed in: its deepest point is then any of many, and a full velocity response
-        // there would come from round-off.
-        if (c.distance >= offset - round_off) continue;
+        if (c.distance >= offset) continue;
         double depth = offset - c.distance;
         Vec3 side = c.normal;
         // The point's own path over the step, in the solid's frame at each end's time, says
@@ -410,8 +459,11 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         CellPush push;
         push.triangle = triangle(kc, lc, tri);
         push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
-        push.velocity_change =
-            velocity_change(s, s.proposed.pose.to_world(point), normal, velocity);
+        const Vec3 world_point = s.proposed.pose.to_world(point);
+        push.velocity_change = velocity_change(s, world_point, normal, velocity);
+        push.normal = normal;
+        push.surface = surface_velocity(s.proposed, world_point);
+        push.velocity = velocity;
         push.move = depth * normal + slip_correction(push.velocity_change, normal);
         rows[static_cast<std::size_t>(lc - lc0)].push_back(push);
       }
@@ -429,8 +481,11 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k) {
-      Vec3 move, dv;
-      bool pushed = false;
+      // Each triangle asks its nodes for the whole move that clears it, so a node's pushes
+      // are averaged, not added: added, the up to six triangles of a node resting on a box's
+      // edge moved it up to six times too far, and the next step it fell back.
+      Vec3 move, dv, normal, surface, velocity;
+      int pushes = 0;
       for (const Around& a : around) {
         const int kc = k + a.dk, lc = l + a.dl;
         if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
@@ -440,15 +495,19 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         const double weight = push.weights[static_cast<std::size_t>(a.corner)];
         move += weight * push.move;
         dv += weight * push.velocity_change;
-        pushed = true;
+        normal += weight * push.normal;
+        surface += push.surface;
+        velocity += push.velocity;
+        ++pushes;
       }
-      if (!pushed) continue;
+      if (pushes == 0 || dot(normal, normal) == 0.0) continue;
+      const double share = 1.0 / pushes;
       Vec3& r = next(k, l);
       const Vec3 r_before = r;
       const Vec3 v_before = velocity_(k, l);
-      r += move;
-      velocity_(k, l) += dv;
-      touched_(k, l) = 1;
+      r += share * move;
+      velocity_(k, l) += share * dv;
+      remember(s, k, l, normal / norm(normal), share * surface, share * velocity);
       record(solid, pass, 1, k, l, r_before, v_before, r,
              exchange_rows[static_cast<std::size_t>(l - b.l0)]);
     }
@@ -518,6 +577,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
 
   if (any_free_) apply_impulses(exchanges);
+  settle(current, next);
   long local = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k)

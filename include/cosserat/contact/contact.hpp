@@ -84,6 +84,13 @@ class Contact {
   Vec3 slip_correction(const Vec3& change, const Vec3& normal) const;
   void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
+  // Node (k, l) met solid s with world normal n, arriving at `velocity` against a surface
+  // moving at `surface`: what settle() needs to make its velocity consistent.
+  void remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& surface,
+                const Vec3& velocity);
+  // The velocity each node touched only by fixed and kinematic solids leaves with: what it
+  // moved over the step, with the response's normal part (docs/contact.md, "Velocities").
+  void settle(const Field<Vec3>& current, const Field<Vec3>& next);
   void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                  std::vector<Exchange>& out);
   void cell_pass(int pass, std::size_t solid, const Field<Vec3>& current, Field<Vec3>& next,
@@ -104,7 +111,10 @@ class Contact {
   std::vector<double> turn_;   // and its turn (rad)
   bool any_free_ = false;
   Field<Vec3> velocity_;           // the nodes' velocities during a response
-  Field<unsigned char> touched_;   // nodes the response changed
+  Field<unsigned char> touched_;   // nodes the response changed: kTouched, kByFreeBody
+  Field<Vec3> contact_normal_;     // their last contact's world normal
+  Field<Vec3> surface_velocity_;   // and that surface's velocity there
+  Field<double> normal_speed_;     // and the response's normal speed away from it
   Field<double> distance_;         // cell_pass: a lower bound of each node's signed distance
   Field<Vec3> normal_;             // and the normal there (solid's frame), zero when far
   std::vector<CellPush> cells_;    // cell_pass: the triangles pressed in
