@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -119,6 +120,18 @@ Vec3 surface_velocity(const SolidState& body, const Vec3& x) {
   return body.velocity + cross(body.angular_velocity, x - body.pose.position);
 }
 
+// The smallest radius of curvature of a shape's curved faces (infinite for flat ones).
+double curved_radius(const Shape& shape) {
+  switch (shape.kind) {
+    case ShapeKind::sphere:
+    case ShapeKind::cylinder:
+    case ShapeKind::capsule:
+      return shape.radius;
+    default:
+      return std::numeric_limits<double>::infinity();
+  }
+}
+
 // The angle a frame turns through from orientation a to b.
 double turn_angle(const Quaternion& a, const Quaternion& b) {
   const double c = std::min(1.0, std::abs(a.w * b.w + a.x * b.x + a.y * b.y + a.z * b.z));
@@ -157,7 +170,6 @@ struct Contact::CellPush {
   Vec3 velocity_change;
   Vec3 normal;   // world
   Vec3 surface;  // the solid's surface velocity at the point
-  Vec3 velocity;  // the point's before the push
 };
 
 Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo,
@@ -359,12 +371,20 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const Block& b = *block_;
   const Solid& s = solids_[solid];
   const SolidGeometry& g = s.geometry;
-  // Nodes rest on the offset surface; a triangle is pressed in only when it reaches half way
-  // to the solid, and goes back out to there (docs/contact.md, "Cells"). Testing it against
-  // the offset surface itself pushed every triangle resting on a curved solid out by its
-  // chord's sag, h²/8R, every step, which lifted its nodes off: they jittered, and without
-  // a normal force friction let them slide off a sphere.
-  const double offset = 0.5 * s.spec.thickness;
+  // Nodes rest on the offset surface; a triangle is pressed in only when its deepest point
+  // reaches half way to the solid, or, nearest a curved face of radius R at least its longest
+  // edge L, deeper than the sag L²/8R of a chord whose ends rest on that face; it goes back
+  // out to there (docs/contact.md, "Cells"). Tested against the offset surface itself, every
+  // triangle resting on a curved solid was pushed out by its sag every step, which lifted its
+  // nodes off: they jittered, and without a normal force friction let them slide off a sphere.
+  const double thickness = s.spec.thickness;
+  const double curvature_radius = curved_radius(s.spec.shape);
+  const double flat_offset = 0.5 * thickness;
+  const auto curved_offset = [&](double longest) {
+    if (longest > curvature_radius) return flat_offset;
+    const double sag = longest * longest / (8.0 * (curvature_radius + thickness));
+    return std::min(flat_offset, thickness - sag);
+  };
   const double radius = g.bounding_radius();
   const bool convex = s.spec.shape.kind != ShapeKind::mesh;
   halo_->exchange(next);
@@ -380,7 +400,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   for (int l = lc0; l <= lc1; ++l)
     for (int k = kc0; k <= kc1; ++k) {
       const double outside_ball = norm(next(k, l) - s.proposed.pose.position) - radius;
-      if (outside_ball > offset) {
+      if (outside_ball > thickness) {
         distance_(k, l) = outside_ball;
         normal_(k, l) = {};
       } else {
@@ -413,7 +433,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           const auto& b2 = nodes[(v + 1) % 3];
           longest = std::max(longest, norm(next(b2[0], b2[1]) - next(a[0], a[1])));
         }
-        if (nearest - longest >= offset) continue;
+        if (nearest - longest >= flat_offset) continue;
         std::array<Vec3, 3> p;
         for (int v = 0; v < 3; ++v) p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
         // The signed distance to a convex solid lies above its tangent plane at each node, so
@@ -428,12 +448,15 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
             for (int j = 0; j < 3; ++j) reach = std::min(reach, dot(n, p[j] - p[v]));
             lower = std::max(lower, distance_(nodes[v][0], nodes[v][1]) + reach);
           }
-          if (lower >= offset) continue;
+          if (lower >= flat_offset) continue;
         }
         const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
         if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
         const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
         const Closest c = g.closest(point);
+        // A cylinder's side is curved (its normal radial); its caps and rims are not.
+        const bool curved = s.spec.shape.kind != ShapeKind::cylinder || c.normal.z == 0.0;
+        const double offset = curved ? curved_offset(longest) : flat_offset;
         if (c.distance >= offset) continue;
         double depth = offset - c.distance;
         Vec3 side = c.normal;
@@ -463,7 +486,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         push.velocity_change = velocity_change(s, world_point, normal, velocity);
         push.normal = normal;
         push.surface = surface_velocity(s.proposed, world_point);
-        push.velocity = velocity;
         push.move = depth * normal + slip_correction(push.velocity_change, normal);
         rows[static_cast<std::size_t>(lc - lc0)].push_back(push);
       }
@@ -484,7 +506,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       // Each triangle asks its nodes for the whole move that clears it, so a node's pushes
       // are averaged, not added: added, the up to six triangles of a node resting on a box's
       // edge moved it up to six times too far, and the next step it fell back.
-      Vec3 move, dv, normal, surface, velocity;
+      Vec3 move, dv, normal, surface;
       int pushes = 0;
       for (const Around& a : around) {
         const int kc = k + a.dk, lc = l + a.dl;
@@ -497,7 +519,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         dv += weight * push.velocity_change;
         normal += weight * push.normal;
         surface += push.surface;
-        velocity += push.velocity;
         ++pushes;
       }
       if (pushes == 0 || dot(normal, normal) == 0.0) continue;
@@ -507,7 +528,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       const Vec3 v_before = velocity_(k, l);
       r += share * move;
       velocity_(k, l) += share * dv;
-      remember(s, k, l, normal / norm(normal), share * surface, share * velocity);
+      remember(s, k, l, normal / norm(normal), share * surface, v_before);
       record(solid, pass, 1, k, l, r_before, v_before, r,
              exchange_rows[static_cast<std::size_t>(l - b.l0)]);
     }
