@@ -198,8 +198,8 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
 }
 
 // Threads are set before the simulation is built, so that its fields are first touched by the
-// threads that will work on them. Returns this rank's count.
-int set_threads(const cosserat::Decomposition& decomposition, std::optional<int> requested,
+// threads that will work on them.
+cosserat::ThreadPlacement set_threads(const cosserat::Decomposition& decomposition, std::optional<int> requested,
                 int rank) {
   const cosserat::ThreadPlacement placement = cosserat::place_threads(
       MPI_COMM_WORLD, decomposition.block(rank, MPI_COMM_WORLD).owned_l(), requested);
@@ -218,7 +218,7 @@ int set_threads(const cosserat::Decomposition& decomposition, std::optional<int>
                placement.idle_cpus, placement.idle_cpus == 1 ? "" : "s",
                placement.idle_cpus == 1 ? "is" : "are", placement.idle_cpus == 1 ? "s" : "",
                placement.idle_cpus == 1 ? "it" : "them");
-  return placement.threads;
+  return placement;
 }
 
 // Runs `work` and turns the bad input it reports into a message from rank 0: exit status 2, or
@@ -325,7 +325,8 @@ int run(const RunOptions& options, int rank, int ranks) {
     }
   MPI_Bcast(&conflicting, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (conflicting) return kExitBadInput;
-  const int threads = set_threads(*decomposition, options.threads, rank);
+  const cosserat::ThreadPlacement placement = set_threads(*decomposition, options.threads, rank);
+  const int threads = placement.threads;
 
   // The semi-implicit baseline checks its solver names with PETSc while it is set up.
   std::unique_ptr<Simulation> simulation_owner;
@@ -405,7 +406,7 @@ int run(const RunOptions& options, int rank, int ranks) {
   const StepLoopResult loop = run_step_loop(
       simulation, scene,
       StepLoopOptions{options.checkpoint_every, options.until_rest, rest_peak.value_or(0.0),
-                      adaptive_scale},
+                      adaptive_scale, placement.requested ? 1 : threads},
       observer);
   progress.finish();
 

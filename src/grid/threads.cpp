@@ -170,4 +170,81 @@ void RowBalance::rebalance() {
   }
 }
 
+namespace {
+
+// A window ends after at least this many steps and this much wall time: long enough that one
+// descheduling of a few milliseconds does not decide it, short enough that a slow trial costs
+// little.
+constexpr long kWindowSteps = 20;
+constexpr double kWindowSeconds = 0.05;
+// Windows at the best count between two explorations: with two candidates, one window in
+// this many is spent timing the other, a few per cent of a run at most.
+constexpr long kHoldWindows = 40;
+// The windows after a choice that check it.
+constexpr long kCheckWindows = 3;
+// A candidate must be this much faster to replace the one in use: timing noise on a VM is a
+// few per cent (docs/kernel.md).
+constexpr double kMargin = 0.95;
+
+}  // namespace
+
+ThreadTuner::ThreadTuner(int most) {
+  for (int t = std::max(most, 1); t >= 1; t /= 2) {
+    counts_.push_back(t);
+    if (t == 1) break;
+  }
+  per_step_.assign(counts_.size(), 0.0);
+  steps_with_.assign(static_cast<std::size_t>(std::max(most, 1)), 0);
+  exploring_ = counts_.size() > 1;
+  current_ = counts_.front();
+}
+
+void ThreadTuner::use(int threads) {
+  if (threads != current_) omp_set_num_threads(threads);
+  current_ = threads;
+}
+
+void ThreadTuner::record(double seconds) {
+  ++steps_with_[static_cast<std::size_t>(current_ - 1)];
+  if (counts_.size() < 2) return;
+  ++window_steps_;
+  window_seconds_ += seconds;
+  if (window_steps_ < kWindowSteps || window_seconds_ < kWindowSeconds) return;
+  const double per_step = window_seconds_ / static_cast<double>(window_steps_);
+  window_steps_ = 0;
+  window_seconds_ = 0.0;
+  // The first window touches the fields and the row buffers for the first time.
+  if (!warm_) {
+    warm_ = true;
+    return;
+  }
+  if (exploring_) {
+    per_step_[trial_] = per_step;
+    if (++trial_ < counts_.size()) {
+      use(counts_[trial_]);
+      return;
+    }
+    // The one in use before keeps its place unless another is clearly faster.
+    std::size_t best = best_;
+    for (std::size_t i = 0; i < counts_.size(); ++i)
+      if (per_step_[i] < kMargin * per_step_[best]) best = i;
+    best_ = best;
+    exploring_ = false;
+    windows_held_ = 0;
+    held_seconds_ = 0.0;
+    use(counts_[best_]);
+    return;
+  }
+  // A count chosen on one lucky window shows itself in the next few: then it is timed again at
+  // once rather than kept for kHoldWindows.
+  held_seconds_ += per_step;
+  ++windows_held_;
+  const bool disappointing = windows_held_ == kCheckWindows &&
+                             held_seconds_ / kCheckWindows * kMargin > per_step_[best_];
+  if (!disappointing && windows_held_ < kHoldWindows) return;
+  exploring_ = true;
+  trial_ = 0;
+  use(counts_[0]);
+}
+
 }  // namespace cosserat

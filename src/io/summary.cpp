@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "cosserat/grid/reduce.hpp"
 
@@ -55,6 +56,7 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   summary.n = scene.n;
   summary.ranks = placement.ranks;
   summary.threads = placement.threads;
+  summary.thread_steps = loop.thread_steps;
   summary.parts_k = placement.parts_k;
   summary.parts_l = placement.parts_l;
   summary.integrator = integrator_name(scene.integrator);
@@ -145,6 +147,7 @@ std::string to_json(const RunSummary& s) {
   "grid": [{}, {}],
   "ranks": {},
   "threads": {},
+  "thread_steps": [{}],
   "split": [{}, {}],
   "integrator": {},
   "discretisation": {},
@@ -172,7 +175,8 @@ std::string to_json(const RunSummary& s) {
   "solids": {}
 }}
 )",
-      json_string(s.scene), s.m, s.n, s.ranks, s.threads, s.parts_k, s.parts_l,
+      json_string(s.scene), s.m, s.n, s.ranks, s.threads, fmt::join(s.thread_steps, ", "),
+      s.parts_k, s.parts_l,
       json_string(s.integrator), json_string(s.discretisation), json_number(s.dt), s.steps, json_number(s.sim_time),
       json_number(s.wall_seconds), json_number(s.node_steps_per_second),
       json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "cosserat/grid/threads.hpp"
+
 namespace cosserat {
 
 bool RestSummary::at_rest(long at_step, double kinetic_energy) {
@@ -20,10 +22,18 @@ namespace {
 // these, since an instability grows over many steps before the monitor sees it.
 constexpr long kSnapshotEvery = 100;
 
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
 void fixed_steps(Simulation& simulation, const Scene& scene, const StepLoopOptions& options,
-                 StepObserver& observer, StepLoopResult& result) {
+                 StepObserver& observer, StepLoopResult& result, ThreadTuner& tuner) {
   while (simulation.step_index() < scene.steps) {
+    const auto started = Clock::now();
     result.failure = simulation.step();
+    tuner.record(seconds_since(started));
     if (result.failure) break;
     const long step = simulation.step_index();
     const bool at_rest =
@@ -38,7 +48,7 @@ void fixed_steps(Simulation& simulation, const Scene& scene, const StepLoopOptio
 }
 
 void adaptive_steps(Simulation& simulation, const Scene& scene, const StepLoopOptions& options,
-                    StepObserver& observer, StepLoopResult& result) {
+                    StepObserver& observer, StepLoopResult& result, ThreadTuner& tuner) {
   Stepper& stepper = simulation.stepper();
   AdaptiveSteps steps(scene, options.adaptive_scale);
   AdaptiveSummary& summary = result.adaptive.emplace();
@@ -50,7 +60,10 @@ void adaptive_steps(Simulation& simulation, const Scene& scene, const StepLoopOp
   while (simulation.time() < scene.duration && simulation.step_index() < scene.steps) {
     const double estimate = stability_estimate(scene, simulation.state_measures());
     const AdaptiveSteps::Next next = steps.next(simulation.time(), stepper.last_dt(), estimate);
-    if (auto failure = stepper.step(next.dt, next.end_time)) {
+    const auto started = Clock::now();
+    auto failure = stepper.step(next.dt, next.end_time);
+    tuner.record(seconds_since(started));
+    if (failure) {
       if (failure->solver_failure || !steps.shrink(next.dt)) {
         if (!failure->solver_failure)
           failure->diagnosis += fmt::format(
@@ -96,18 +109,19 @@ void adaptive_steps(Simulation& simulation, const Scene& scene, const StepLoopOp
 
 StepLoopResult run_step_loop(Simulation& simulation, const Scene& scene,
                              const StepLoopOptions& options, StepObserver& observer) {
-  using Clock = std::chrono::steady_clock;
   StepLoopResult result;
+  ThreadTuner tuner(options.tune_threads);
   result.first_step = simulation.step_index();
   if (options.until_rest)
     result.rest = RestSummary{*options.until_rest, options.rest_peak, std::nullopt};
   const double halo_before = simulation.halo_seconds();
   const auto start = Clock::now();
   if (scene.adaptive)
-    adaptive_steps(simulation, scene, options, observer, result);
+    adaptive_steps(simulation, scene, options, observer, result, tuner);
   else
-    fixed_steps(simulation, scene, options, observer, result);
-  result.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    fixed_steps(simulation, scene, options, observer, result, tuner);
+  result.wall_seconds = seconds_since(start);
+  result.thread_steps = tuner.steps_with();
   result.halo_seconds = simulation.halo_seconds() - halo_before;
   return result;
 }

@@ -113,7 +113,9 @@ void expect_at_rest(const RestRecord& r, const char* what, bool energy_falls) {
               r.energy_scale, r.last_frame_move, r.largest_speed_gap);
   EXPECT_LT(r.final_kinetic, 1e-9 * r.peak_kinetic) << what;
   EXPECT_LT(r.last_frame_move, 1e-6) << what;
-  if (energy_falls) EXPECT_LE(r.largest_rise, 1e-6 * r.peak_kinetic) << what;
+  if (energy_falls) {
+    EXPECT_LE(r.largest_rise, 1e-6 * r.peak_kinetic) << what;
+  }
   // Backward difference (r − r⁻)/Δt against the last step's move.
   EXPECT_LT(r.largest_speed_gap, 1e-5) << what;
 }

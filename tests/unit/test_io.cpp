@@ -752,7 +752,7 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
     keys.push_back((*it)[1]);
   }
   const std::vector<std::string> expected{
-      "scene",         "grid",          "ranks",          "threads",       "split",
+      "scene",         "grid",          "ranks",          "threads",  "thread_steps",  "split",
       "integrator",    "discretisation", "dt",          "steps",          "sim_time",
       "wall_seconds",  "node_steps_per_second",           "halo_seconds",
       "restarted_from", "status",

@@ -100,3 +100,51 @@ TEST(RowBalance, OneSlowStepMovesFewRowsAndEveryBandKeepsARow) {
 
 }  // namespace
 }  // namespace cosserat
+
+namespace cosserat {
+namespace {
+
+// A machine on which a step costs `seconds_with[t − 1]` with t threads: the tuner settles on
+// the cheapest count, and moves when the costs change, as when another program starts on one
+// of the cores.
+// Returns how many of the last half of `steps` ran at `expected` threads.
+long steps_at(ThreadTuner& tuner, const std::vector<double>& seconds_with, int expected,
+              long steps) {
+  long at_expected = 0;
+  for (long i = 0; i < steps; ++i) {
+    const int threads = omp_get_max_threads();
+    if (i >= steps / 2 && threads == expected) ++at_expected;
+    tuner.record(seconds_with[static_cast<std::size_t>(threads - 1)]);
+  }
+  return at_expected;
+}
+
+TEST(ThreadTuner, KeepsTheFastestCountAndFollowsTheMachine) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(2);
+  ThreadTuner tuner(2);
+  // Idle: two threads take half the time. 0.01 s a step or more: windows of 20 steps.
+  const long idle = steps_at(tuner, {0.02, 0.01}, 2, 4000);
+  // Busy: a thread waits for a shared core; one thread is faster.
+  const long busy = steps_at(tuner, {0.01, 0.03}, 1, 4000);
+  omp_set_num_threads(before);
+  // Settled, one window in 42 times the other count: 95 % of the steps at the best.
+  EXPECT_GT(idle, 0.95 * 2000);
+  EXPECT_GT(busy, 0.95 * 2000);
+  const std::vector<long>& steps = tuner.steps_with();
+  ASSERT_EQ(steps.size(), 2u);
+  EXPECT_EQ(steps[0] + steps[1], 8000);
+}
+
+TEST(ThreadTuner, OneThreadIsLeftAlone) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(1);
+  ThreadTuner tuner(1);
+  for (int i = 0; i < 500; ++i) tuner.record(1.0);
+  EXPECT_EQ(omp_get_max_threads(), 1);
+  EXPECT_EQ(tuner.steps_with().at(0), 500);
+  omp_set_num_threads(before);
+}
+
+}  // namespace
+}  // namespace cosserat

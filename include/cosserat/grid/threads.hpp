@@ -62,4 +62,41 @@ class RowBalance {
   std::vector<double> row_cost_;  // seconds a row, smoothed over the steps
 };
 
+// Picks the size of a rank's thread team, step by step, from the steps' measured wall time
+// (docs/parallel.md, "Threads that fit the machine"). The default count suits an idle machine
+// (two threads run S2's 20 x 20 sheet 1.9 times as fast as one on two idle cores), but every
+// step ends at a barrier that waits for the slowest thread, and a thread whose core another
+// program holds is descheduled for milliseconds at a time: with a busy process on one of two
+// cores, two threads took 2.4 times as long as one on S2. No setting of the waiting threads
+// fixes that from outside (OMP_WAIT_POLICY=passive came within 8–12 % of one thread, but cost
+// 48 % on S6 on an idle machine), so the tuner times each count it may use, 1 to the default
+// halving, over windows of steps, keeps the fastest, and times the others again now and then:
+// the machine's load changes during a run. Where the rows go changes no bit of the result.
+class ThreadTuner {
+ public:
+  // Tunes between 1 and `most` threads (the default count); with `most` = 1 it does nothing.
+  explicit ThreadTuner(int most);
+  // After a step that took `seconds` (of wall time, the step alone): may set OpenMP's thread
+  // count for the steps that follow.
+  void record(double seconds);
+  // Steps run so far with each count, index = threads − 1.
+  const std::vector<long>& steps_with() const { return steps_with_; }
+
+ private:
+  void use(int threads);
+
+  std::vector<int> counts_;        // the candidates: most, most/2, ..., 1
+  std::vector<double> per_step_;   // each one's last measured seconds a step
+  std::vector<long> steps_with_;
+  std::size_t trial_ = 0;          // the candidate being timed, while exploring
+  bool exploring_ = true;
+  bool warm_ = false;              // the first window was seen (and not counted)
+  std::size_t best_ = 0;
+  long window_steps_ = 0;
+  double window_seconds_ = 0.0;
+  long windows_held_ = 0;          // windows at the best count since the last exploration
+  double held_seconds_ = 0.0;      // their seconds a step, summed
+  int current_ = 1;
+};
+
 }  // namespace cosserat

@@ -21,6 +21,7 @@ struct RunSummary {
   int n = 0;
   int ranks = 1;
   int threads = 1;
+  std::vector<long> thread_steps;  // rank 0's steps with 1, 2, ... threads (ThreadTuner)
   int parts_k = 1, parts_l = 1;  // the decomposition: blocks along k times along l
   std::string integrator;
   double dt = 0.0;

@@ -5,6 +5,7 @@
 // the schedule without writing any.
 
 #include <optional>
+#include <vector>
 
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/simulation.hpp"
@@ -29,6 +30,9 @@ struct StepLoopOptions {
   double rest_peak = 0.0;  // a restarted run's peak kinetic energy so far (from its checkpoint)
   // Adaptive steps: what a restarted run's roll-backs left of the estimate (its checkpoint's).
   double adaptive_scale = 1.0;
+  // The most threads a ThreadTuner may give this rank's team (the default count); 1: the count
+  // stays as it was set (the user chose it).
+  int tune_threads = 1;
 };
 
 // What a restart must continue from besides the simulation's state.
@@ -61,6 +65,8 @@ struct StepLoopResult {
   std::optional<AdaptiveSummary> adaptive;  // with adaptive steps only
   double wall_seconds = 0.0;
   double halo_seconds = 0.0;  // of the wall time, in halo exchanges on this rank
+  // Steps this rank ran with 1, 2, ... threads (index = threads − 1).
+  std::vector<long> thread_steps;
 };
 
 // Steps `simulation` up to scene.steps (with adaptive steps: to scene.duration), stopping early
