@@ -50,8 +50,10 @@ Closest box_closest(const Vec3& p, const Vec3& half) {
   return {q[axis], normal};
 }
 
+// sqrt of the sums rather than std::hypot, which guards against overflow no contact coordinate
+// comes near and cost a third of the tablecloth's contact time (27.6 million calls).
 Closest cylinder_closest(const Vec3& p, double radius, double half_length) {
-  const double r = std::hypot(p.x, p.y);
+  const double r = std::sqrt(p.x * p.x + p.y * p.y);
   const Vec3 radial = r > 0.0 ? Vec3{p.x / r, p.y / r, 0.0} : Vec3{1.0, 0.0, 0.0};
   const Vec3 axial{0.0, 0.0, p.z < 0.0 ? -1.0 : 1.0};
   const double side = r - radius;
@@ -59,7 +61,7 @@ Closest cylinder_closest(const Vec3& p, double radius, double half_length) {
   if (side > 0.0 || cap > 0.0) {
     const double s = std::max(side, 0.0);
     const double c = std::max(cap, 0.0);
-    const double gap = std::hypot(s, c);
+    const double gap = std::sqrt(s * s + c * c);
     return {gap, (s / gap) * radial + (c / gap) * axial};
   }
   if (cap >= side) return {cap, axial};
@@ -501,18 +503,37 @@ Weights cylinder_pressed(double radius, double half_length, const Vec3& a, const
 // the axis and rim samples) and a compass search from the best cover that.
 Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const Vec3& b,
                          const Vec3& c) {
+  // Beside the side, away from the caps, the distance is ρ − R, ρ the distance from the axis:
+  // the deepest point is then the point of the triangle's shadow on the xy-plane nearest the
+  // axis, in closed form. That holds when every corner is within |z| <= H (so is the whole
+  // triangle: |z| is convex) and ρ − R there is at least the caps' largest |z| − H on the
+  // triangle, its largest at a corner: then max(ρ − R, |z| − H), and the distance outside, is
+  // ρ − R at that point and no less anywhere. A cloth hanging beside a round table's side takes
+  // this path; the search below is for the rims.
+  const double top = std::max({std::abs(a.z), std::abs(b.z), std::abs(c.z)});
+  if (top <= half_length) {
+    const Vec3 fa{a.x, a.y, 0.0}, fb{b.x, b.y, 0.0}, fc{c.x, c.y, 0.0};
+    const Weights w = closest_on_triangle({0.0, 0.0, 0.0}, fa, fb, fc);
+    if (norm(at(w, fa, fb, fc)) - radius >= top - half_length) return clean(w);
+  }
   std::vector<Weights> candidates{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
   candidates.push_back(closest_on_triangle({0.0, 0.0, 0.0}, a, b, c));
   candidates.push_back(
       closest_segment_triangle({0.0, 0.0, -half_length}, {0.0, 0.0, half_length}, a, b, c));
+  // The rim samples' directions, computed once: their sines and cosines were 4 % of a round
+  // table's run.
   constexpr int kRimSamples = 16;
-  for (int j = 0; j < kRimSamples; ++j) {
-    const double phi = 2.0 * std::numbers::pi * j / kRimSamples;
-    for (const double z : {-half_length, half_length}) {
-      candidates.push_back(
-          closest_on_triangle({radius * std::cos(phi), radius * std::sin(phi), z}, a, b, c));
+  static const std::array<std::pair<double, double>, kRimSamples> rim = [] {
+    std::array<std::pair<double, double>, kRimSamples> directions{};
+    for (int j = 0; j < kRimSamples; ++j) {
+      const double phi = 2.0 * std::numbers::pi * j / kRimSamples;
+      directions[static_cast<std::size_t>(j)] = {std::cos(phi), std::sin(phi)};
     }
-  }
+    return directions;
+  }();
+  for (const auto& [cosine, sine] : rim)
+    for (const double z : {-half_length, half_length})
+      candidates.push_back(closest_on_triangle({radius * cosine, radius * sine, z}, a, b, c));
   const auto distance = [&](const Weights& w) {
     return cylinder_closest(at(w, a, b, c), radius, half_length).distance;
   };
