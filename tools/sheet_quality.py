@@ -20,6 +20,14 @@ Per frame, from /positions [frames, m, n, 3] (node [k, l] at [f, k, l, :], docs/
               hundred frames takes seconds.
   area ratio  S / S0, S the sum over cells of the two triangles (k,l)(k+1,l)(k,l+1) and
               (k+1,l+1)(k,l+1)(k+1,l).
+  zig-zag     the grid-scale crinkle: along each grid line the second differences
+              D_k = r[k+1] - 2 r[k] + r[k-1] of neighbouring nodes; a smooth fold, resolved by
+              the grid, has D_k close to D_k+1, a zig-zag at the grid's own scale (the
+              highest frequency it holds, r[k] = (-1)^k a) has D_k = -D_k+1. "zz amp" is the
+              largest |D_k - D_k+1| / 8 (metres: a for that zig-zag), "zz frac" the share of
+              sum |D_k - D_k+1|^2 in sum |D_k - D_k+1|^2 + |D_k + D_k+1|^2 over both grid
+              directions: sin²(π h/λ) for a fold of wavelength λ (0.024 at 20 nodes a
+              wavelength), 1 for a pure zig-zag.
 
 Prints a table (one line per frame, then the extremes over the run); --json prints one JSON
 object {"file", "grid", "h", "frames": [...], "overall": {...}} instead.
@@ -101,6 +109,25 @@ def proximity(r, h):
     return count, ratio
 
 
+def zigzag(r):
+    """(largest grid-scale amplitude in metres, grid-scale share of the curvature) of one frame,
+    both grid directions together; (0, 0) on a sheet too small or too flat to say."""
+    high = low = 0.0
+    amplitude = 0.0
+    for axis in (0, 1):
+        x = np.moveaxis(r, axis, 0)
+        if x.shape[0] < 4:
+            continue
+        d = x[2:] - 2.0 * x[1:-1] + x[:-2]
+        minus = d[1:] - d[:-1]
+        plus = d[1:] + d[:-1]
+        high += float((minus ** 2).sum())
+        low += float((plus ** 2).sum())
+        amplitude = max(amplitude, float(np.linalg.norm(minus, axis=-1).max()) / 8.0)
+    share = high / (high + low) if high + low > 0.0 else 0.0
+    return amplitude, share
+
+
 def analyse(path, every=1):
     with h5py.File(path, "r") as f:
         pos = f["/positions"]
@@ -131,6 +158,7 @@ def analyse(path, every=1):
             min_cos = min(float(cos_k.min()) if cos_k.size else 1.0,
                           float(cos_l.min()) if cos_l.size else 1.0)
             finite = bool(np.isfinite(r).all())
+            zz_amp, zz_frac = zigzag(r) if finite else (None, None)
             pairs, dmin = proximity(r, h) if finite else (None, None)
             out.append({
                 "frame": fi, "step": int(steps[fi]), "time": float(times[fi]),
@@ -140,6 +168,7 @@ def analyse(path, every=1):
                 "min_normal_cos": min_cos,
                 "close_pairs": pairs, "min_far_distance_over_h": dmin,
                 "area_ratio": area(r) / area0,
+                "zigzag_amplitude": zz_amp, "zigzag_fraction": zz_frac,
             })
         status = f.attrs.get("status", "")
         if isinstance(status, bytes):
@@ -155,7 +184,8 @@ def analyse(path, every=1):
     overall = {"status": status, "frames": len(out)}
     for key, fn in (("min_det_ratio", min), ("min_signed_det_ratio", min),
                     ("inverted_cells", max), ("min_normal_cos", min), ("close_pairs", max),
-                    ("min_far_distance_over_h", min), ("area_ratio", min)):
+                    ("min_far_distance_over_h", min), ("area_ratio", min),
+                    ("zigzag_amplitude", max), ("zigzag_fraction", max)):
         v, t = extreme(key, fn)
         overall[key] = v
         overall[key + "_time"] = t
@@ -183,19 +213,21 @@ def main():
     print(f"{res['file']}: grid {res['grid'][0]} x {res['grid'][1]}, h = {res['h']:.4g} m, "
           f"status {res['overall']['status'] or '?'}")
     print(f"{'frame':>5} {'time':>8} {'det a/A':>9} {'signed':>9} {'inv':>4} {'min cos':>8} "
-          f"{'pairs<h/2':>9} {'dmin/h':>7} {'S/S0':>7}")
+          f"{'pairs<h/2':>9} {'dmin/h':>7} {'S/S0':>7} {'zz amp':>8} {'zz frac':>7}")
     for fr in res["frames"]:
         print(f"{fr['frame']:5d} {fr['time']:8.3f} {fr['min_det_ratio']:9.3g} "
               f"{fr['min_signed_det_ratio']:9.3g} {fr['inverted_cells']:4d} "
               f"{fr['min_normal_cos']:8.3f} {fmt(fr['close_pairs'], '9d')} "
-              f"{fmt(fr['min_far_distance_over_h'], '7.3f')} {fr['area_ratio']:7.4f}")
+              f"{fmt(fr['min_far_distance_over_h'], '7.3f')} {fr['area_ratio']:7.4f} "
+              f"{fmt(fr['zigzag_amplitude'], '8.2e')} {fmt(fr['zigzag_fraction'], '7.3f')}")
     o = res["overall"]
     print(f"overall: det a/A {o['min_det_ratio']:.3g} (t {o['min_det_ratio_time']:.3f}), signed "
           f"{o['min_signed_det_ratio']:.3g}, most inverted cells {o['inverted_cells']}, min cos "
           f"{o['min_normal_cos']:.3f} (t {o['min_normal_cos_time']:.3f}), most pairs<h/2 "
           f"{fmt(o['close_pairs'], 'd')}, dmin/h {fmt(o['min_far_distance_over_h'], '.3f')}, "
           f"S/S0 {o['area_ratio']:.4f}..{o['max_area_ratio']:.4f} (final "
-          f"{o['final_area_ratio']:.4f})")
+          f"{o['final_area_ratio']:.4f}), zig-zag amplitude up to "
+          f"{fmt(o['zigzag_amplitude'], '.2e')} m, share up to {fmt(o['zigzag_fraction'], '.3f')}")
 
 
 if __name__ == "__main__":
