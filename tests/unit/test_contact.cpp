@@ -64,7 +64,7 @@ Vec3 mean_position(const Simulation& sim) {
 // Coulomb (CONTACT.md §3): on a plane tilted by θ a sheet stays put when tan θ < μ and slides
 // with acceleration g (sin θ − μ cos θ) when tan θ > μ. The plane is y = 0; gravity is tilted
 // instead, so the sheet's slide is along x.
-double slide_acceleration(double theta, double mu, double* drift_when_stuck) {
+double slide_acceleration(double theta, double mu, double* drift_when_stuck, long steps = 500) {
   const double g = 9.81;
   Scene scene = sheet_at(6, 0.5, 0.0);
   scene.gravity = {g * std::sin(theta), -g * std::cos(theta), 0.0};
@@ -76,7 +76,6 @@ double slide_acceleration(double theta, double mu, double* drift_when_stuck) {
   scene.dt = 1e-3;
   Simulation sim(scene, MPI_COMM_SELF);
   const double x0 = mean_position(sim).x;
-  const long steps = 500;
   EXPECT_TRUE(testing::advance(sim, steps));
   const double t = sim.time();
   const double x = mean_position(sim).x - x0;
@@ -101,6 +100,17 @@ TEST(Contact, CoulombFrictionHoldsBelowTheAngleOfReposeAndSlidesAbove) {
                 mu, tan_theta, measured, expected);
     EXPECT_NEAR(measured, expected, 0.02 * expected) << "tan θ = " << tan_theta;
   }
+}
+
+// Static friction over a long time (docs/contact.md, "Velocities"): stuck below the angle of
+// repose, the sheet stays where it is for 10 s, every step's tangential push undone.
+TEST(Contact, StaticFrictionHoldsForTenSeconds) {
+  const double mu = 0.5;
+  double drift = 0.0;
+  slide_acceleration(std::atan(0.8 * mu), mu, &drift, 10000);
+  std::printf("[Coulomb] mu = %.1f, tan theta = %.1f: moved %.3g m in 10 s\n", mu, 0.8 * mu,
+              drift);
+  EXPECT_LT(drift, 1e-6);
 }
 
 // Restitution (CONTACT.md §3): a flat sheet without stiffness dropped from height H onto a
