@@ -303,6 +303,46 @@ TEST(Scene, MeasuredPresetsFollowTheirKesNumbers) {
   }
 }
 
+// The fabrics Wang, O'Brien and Ramamoorthi (2011) measured, from the numbers of ARCSim's files
+// (docs/materials.md, "Measured fabrics: Wang et al. (2011)"): ζ₁₁ = c11/3, ζ₂₂ = c22/3,
+// ζ₁₂ = c33/2 of the stretching table's row 0; B = k_e/4 of the bending table's column 0, ξ₁₁
+// from the hinge along v, ξ₂₂ from the hinge along u, ξ₁₂ = B₄₅ − (B₁ + B₂)/4; φ at 0.03 of its
+// bound. Each is a real fabric: 100-350 g/m², a bending length of 1-3 cm along both axes.
+TEST(Scene, WangFabricsFollowTheirTables) {
+  const Preset denim = *find_preset("11oz-black-denim");
+  EXPECT_EQ(denim.area, 1.0);
+  EXPECT_EQ(denim.mass, 0.324);
+  EXPECT_DOUBLE_EQ(denim.zeta[0], 205.352 / 3.0);
+  EXPECT_DOUBLE_EQ(denim.zeta[1], 53.3872 / 2.0);
+  EXPECT_DOUBLE_EQ(denim.zeta[2], 1013.89 / 3.0);
+  EXPECT_DOUBLE_EQ(denim.xi[0], 9.69516e-05 / 24.0);
+  EXPECT_DOUBLE_EQ(denim.xi[1], 7.33846e-05 / 4.0 - (9.69516e-05 + 6.41965e-05) / 16.0);
+  EXPECT_DOUBLE_EQ(denim.xi[2], 6.41965e-05 / 24.0);
+  for (std::size_t i = 0; i < 3; ++i)
+    EXPECT_DOUBLE_EQ(denim.phi[i], 0.03 * 2.0 * std::sqrt(denim.zeta[i] * denim.xi[i]));
+  for (const char* name :
+       {"11oz-black-denim", "royal-target", "gray-interlock", "ivory-rib-knit",
+        "white-dots-on-blk", "pink-ribbon-brown", "tango-red-jet-set", "navy-sparkle-sweat",
+        "camel-ponte-roma", "white-swim-solid"}) {
+    SCOPED_TRACE(name);
+    const auto preset = find_preset(name);
+    ASSERT_TRUE(preset.has_value());
+    EXPECT_EQ(preset->area, 1.0);
+    EXPECT_GT(preset->mass, 0.1);
+    EXPECT_LT(preset->mass, 0.35);
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_GT(preset->zeta[i], 0.0);
+      EXPECT_GT(preset->xi[i], 0.0);
+      EXPECT_LT(preset->phi[i] * preset->phi[i], 4.0 * preset->zeta[i] * preset->xi[i]);
+    }
+    for (std::size_t i : {0u, 2u}) {
+      const double bending_length = std::cbrt(6.0 * preset->xi[i] / (preset->mass * 9.81));
+      EXPECT_GT(bending_length, 0.01);
+      EXPECT_LT(bending_length, 0.03);
+    }
+  }
+}
+
 TEST(Scene, KeysBesidePresetOverrideIt) {
   SceneText text;
   text.material = "preset = \"denim-10m\"\nxi = [0.1, 0.2, 0.3]\nmass = 3.0\n";
@@ -350,7 +390,7 @@ TEST(Scene, DensityConvertsToTotalMass) {
 
 // The published calibrations, kept under their own names with the 10 m sheet they are for.
 TEST(Scene, PublishedCalibrationsKeepTheirNumbers) {
-  ASSERT_EQ(material_presets().size(), 18u);
+  ASSERT_EQ(material_presets().size(), 28u);
   const auto canvas = find_preset("coated-cotton-10m");
   ASSERT_TRUE(canvas.has_value());
   EXPECT_EQ(canvas->mass, 125.0);
@@ -890,7 +930,10 @@ TEST(SceneError, UnknownPreset) {
   text.material = "preset = \"tweed\"\n";
   EXPECT_THAT(error_of(text),
               AllOf(HasSubstr("key 'material.preset'"), HasSubstr("unknown preset \"tweed\""),
-                    HasSubstr("allowed: silk, cotton, linen, wool, polyester, denim, silk-10m")));
+                    HasSubstr("allowed: silk, cotton, linen, wool, polyester, denim, "
+                              "11oz-black-denim, royal-target, gray-interlock, ivory-rib-knit, "
+                              "white-dots-on-blk, pink-ribbon-brown, tango-red-jet-set, "
+                              "navy-sparkle-sweat, camel-ponte-roma, white-swim-solid, silk-10m")));
 }
 
 TEST(SceneError, UnknownModelAndBorders) {
