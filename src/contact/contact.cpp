@@ -234,13 +234,13 @@ void Contact::propose_free(Solid& s, double dt) const {
   s.proposed_pushing = s.pushing;
 }
 
-// CONTACT.md §3 at a world point of solid s with world normal n, for cloth moving at
-// `velocity` there: the change against the solid's surface as if it could not be moved. A free
-// body's share is settled once all its contacts are known (apply_impulses).
-Vec3 Contact::velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
+// CONTACT.md §3 at a point of solid s whose surface moves at `surface`, with world normal n,
+// for cloth moving at `velocity` there: the change against the solid's surface as if it could
+// not be moved. A free body's share is settled once all its contacts are known
+// (apply_impulses).
+Vec3 Contact::velocity_change(const Solid& s, const Vec3& surface, const Vec3& normal,
                               const Vec3& velocity) const {
-  return respond_velocity(velocity, surface_velocity(s.proposed, point), normal,
-                          s.spec.restitution, s.spec.friction) -
+  return respond_velocity(velocity, surface, normal, s.spec.restitution, s.spec.friction) -
          velocity;
 }
 
@@ -261,17 +261,13 @@ void Contact::remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& 
 // approach, 0 for cloth that does not bounce, a leaving node's own, never the push that put
 // it back on the surface. A free body's nodes keep the response's velocity: their impulses
 // are what the body took (apply_impulses).
-void Contact::settle(const Field<Vec3>& current, const Field<Vec3>& next) {
-  const Block& b = *block_;
-#pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) {
-      if (touched_(k, l) != kTouched) continue;
-      const Vec3 n = contact_normal_(k, l);
-      const Vec3 moved = (next(k, l) - current(k, l)) / dt_;
-      const double normal = dot(moved - surface_velocity_(k, l), n);
-      velocity_(k, l) = moved + (normal_speed_(k, l) - normal) * n;
-    }
+Vec3 Contact::settled_velocity(int k, int l, const Field<Vec3>& current,
+                               const Field<Vec3>& next) const {
+  if (touched_(k, l) != kTouched) return velocity_(k, l);
+  const Vec3 n = contact_normal_(k, l);
+  const Vec3 moved = (next(k, l) - current(k, l)) / dt_;
+  const double normal = dot(moved - surface_velocity_(k, l), n);
+  return moved + (normal_speed_(k, l) - normal) * n;
 }
 
 // The step moved the node with its velocity before the response: friction's change of the
@@ -351,10 +347,11 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
         const Vec3 v_before = velocity_(k, l);
         const Vec3 point = s.proposed.pose.to_world(target);
         const Vec3 n = s.proposed.pose.direction_to_world(normal);
-        const Vec3 change = velocity_change(s, point, n, v_before);
+        const Vec3 surface = surface_velocity(s.proposed, point);
+        const Vec3 change = velocity_change(s, surface, n, v_before);
         r = point + slip_correction(change, n);
         velocity_(k, l) = v_before + change;
-        remember(s, k, l, n, surface_velocity(s.proposed, point), v_before);
+        remember(s, k, l, n, surface, v_before);
         record(i, pass, 0, k, l, r_before, v_before, r, row);
       }
   }
@@ -486,10 +483,9 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         CellPush push;
         push.triangle = triangle(kc, lc, tri);
         push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
-        const Vec3 world_point = s.proposed.pose.to_world(point);
-        push.velocity_change = velocity_change(s, world_point, normal, velocity);
         push.normal = normal;
-        push.surface = surface_velocity(s.proposed, world_point);
+        push.surface = surface_velocity(s.proposed, s.proposed.pose.to_world(point));
+        push.velocity_change = velocity_change(s, push.surface, normal, velocity);
         push.move = depth * normal + slip_correction(push.velocity_change, normal);
         rows[static_cast<std::size_t>(lc - lc0)].push_back(push);
       }
@@ -602,12 +598,11 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
 
   if (any_free_) apply_impulses(exchanges);
-  settle(current, next);
   long local = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k)
       if (touched_(k, l)) {
-        corrected.push_back({k, l, velocity_(k, l)});
+        corrected.push_back({k, l, settled_velocity(k, l, current, next)});
         ++local;
       }
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);

@@ -79,18 +79,18 @@ class Contact {
   struct CellPush;
 
   void propose_free(Solid& s, double dt) const;
-  Vec3 velocity_change(const Solid& s, const Vec3& point, const Vec3& normal,
+  Vec3 velocity_change(const Solid& s, const Vec3& surface, const Vec3& normal,
                        const Vec3& velocity) const;
   Vec3 slip_correction(const Vec3& change, const Vec3& normal) const;
   void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
   // Node (k, l) met solid s with world normal n, arriving at `velocity` against a surface
-  // moving at `surface`: what settle() needs to make its velocity consistent.
+  // moving at `surface`: what settled_velocity() needs to make its velocity consistent.
   void remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& surface,
                 const Vec3& velocity);
-  // The velocity each node touched only by fixed and kinematic solids leaves with: what it
-  // moved over the step, with the response's normal part (docs/contact.md, "Velocities").
-  void settle(const Field<Vec3>& current, const Field<Vec3>& next);
+  // The velocity touched node (k, l) leaves with (docs/contact.md, "Velocities").
+  Vec3 settled_velocity(int k, int l, const Field<Vec3>& current,
+                        const Field<Vec3>& next) const;
   void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                  std::vector<Exchange>& out);
   void cell_pass(int pass, std::size_t solid, const Field<Vec3>& current, Field<Vec3>& next,
