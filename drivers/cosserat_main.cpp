@@ -199,8 +199,8 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
 
 // Threads are set before the simulation is built, so that its fields are first touched by the
 // threads that will work on them.
-cosserat::ThreadPlacement set_threads(const cosserat::Decomposition& decomposition, std::optional<int> requested,
-                int rank) {
+cosserat::ThreadPlacement set_threads(const cosserat::Decomposition& decomposition,
+                                      std::optional<int> requested, int rank) {
   const cosserat::ThreadPlacement placement = cosserat::place_threads(
       MPI_COMM_WORLD, decomposition.block(rank, MPI_COMM_WORLD).owned_l(), requested);
   if (rank == 0 && placement.oversubscribed())
