@@ -19,6 +19,8 @@ namespace {
 // is left for the next step (CONTACT.md §2: a bounded number of repeats).
 constexpr int kMaxPasses = 4;
 
+constexpr double kHuge = std::numeric_limits<double>::infinity();
+
 // What touched_ holds for a node: the response moved it; a free body was among the solids.
 constexpr unsigned char kTouched = 1;
 constexpr unsigned char kByFreeBody = 2;
@@ -150,6 +152,37 @@ double clearance(const SolidGeometry& g, const Vec3& p, const Vec3& n, double of
   return outside;
 }
 
+// Box helpers of the broad phase: the nearest and farthest distance from p to a box, the
+// lowest value of n·x over it.
+double nearest_in(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 d{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
+               std::max({lo.z - p.z, 0.0, p.z - hi.z})};
+  return norm(d);
+}
+double farthest_in(const Vec3& p, const Vec3& lo, const Vec3& hi) {
+  const Vec3 d{std::max(std::abs(p.x - lo.x), std::abs(p.x - hi.x)),
+               std::max(std::abs(p.y - lo.y), std::abs(p.y - hi.y)),
+               std::max(std::abs(p.z - lo.z), std::abs(p.z - hi.z))};
+  return norm(d);
+}
+double lowest_along(const Vec3& n, const Vec3& lo, const Vec3& hi) {
+  return (n.x > 0.0 ? n.x * lo.x : n.x * hi.x) + (n.y > 0.0 ? n.y * lo.y : n.y * hi.y) +
+         (n.z > 0.0 ? n.z * lo.z : n.z * hi.z);
+}
+void widen(Vec3& lo, Vec3& hi, const Vec3& p) {
+  lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+  hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+}
+constexpr Vec3 kEmptyLow{kHuge, kHuge, kHuge};
+constexpr Vec3 kEmptyHigh{-kHuge, -kHuge, -kHuge};
+
+// The broad phase's tests allow for the round-off of the per-node tests they stand in for
+// (the frame's rotation), relative to the distances involved.
+constexpr double kBroadSlack = 1e-9;
+
+// A solid's bit in a tile's mask: the 64th stands for every solid from the 64th on.
+std::uint64_t solid_bit(std::size_t i) { return std::uint64_t{1} << std::min<std::size_t>(i, 63); }
+
 }  // namespace
 
 // One node's change of velocity by a free body in one phase of one pass (CONTACT.md §3): the
@@ -186,6 +219,19 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
       normal_speed_(block),
       distance_(block),
       normal_(block) {
+  if (!solids.empty()) {
+    tiles_k_ = (block.owned_k() + kTile - 1) / kTile;
+    tiles_l_ = (block.owned_l() + kTile - 1) / kTile;
+    const auto tiles = static_cast<std::size_t>(tiles_k_) * static_cast<std::size_t>(tiles_l_);
+    boxes_.resize(tiles);
+    near_.resize(tiles);
+    stale_.resize(tiles);
+    tile_touched_.resize(tiles);
+    cells_near_.resize(tiles);
+    ready_.resize(tiles);
+    exchange_rows_.resize(static_cast<std::size_t>(tiles_l_));
+    push_rows_.resize(static_cast<std::size_t>(tiles_l_));
+  }
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false};
     if (spec.motion == SolidMotion::free) {
@@ -291,6 +337,91 @@ void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const
                  v_before});
 }
 
+// The broad phase (docs/contact.md, "Cost"). Each tile of owned nodes keeps the box holding
+// them at both ends of the step and their largest move; from it, the solids each test below
+// could pass for one of its nodes. A tile no solid can reach is not visited at all. Every
+// test here is implied by the per-node or per-triangle test it spares, so the response is the
+// same as if every node were tested, on any tiling, decomposition or thread count.
+Contact::TileRange Contact::tile_nodes(int i, int j) const {
+  const Block& b = *block_;
+  const int k0 = b.k0 + i * kTile, l0 = b.l0 + j * kTile;
+  return {k0, std::min(k0 + kTile, b.k1), l0, std::min(l0 + kTile, b.l1)};
+}
+
+// The cells (kc, lc) of a tile's nodes, the block's first tile column and row taking the ghost
+// cells kc = k0 − 1 and lc = l0 − 1 too, given by the nodes [kc, kc + 1] x [lc, lc + 1] they
+// span: a cell's far nodes belong to the next tiles or are ghosts.
+Contact::TileRange Contact::tile_cell_nodes(int i, int j) const {
+  const Block& b = *block_;
+  const TileRange t = tile_nodes(i, j);
+  return {i == 0 ? std::max(b.k0 - 1, 0) : t.k0,
+          i == tiles_k_ - 1 ? std::min(b.k1, b.m - 1) : t.k1,
+          j == 0 ? std::max(b.l0 - 1, 0) : t.l0,
+          j == tiles_l_ - 1 ? std::min(b.l1, b.n - 1) : t.l1};
+}
+
+std::uint64_t Contact::near_solids(const Box& box) const {
+  std::uint64_t near = 0;
+  for (std::size_t i = 0; i < solids_.size(); ++i) {
+    const Solid& s = solids_[i];
+    const double offset = s.spec.thickness;
+    bool reach = true;
+    if (s.spec.shape.kind == ShapeKind::plane) {
+      // node_pass meets a plane only at an end closer to it than the offset.
+      const Vec3 n = s.proposed.pose.direction_to_world({0.0, 0.0, 1.0});
+      const Vec3& p = s.proposed.pose.position;
+      const double lowest = lowest_along(n, box.lo, box.hi) - dot(n, p);
+      reach = lowest < offset + kBroadSlack * (offset + farthest_in(p, box.lo, box.hi));
+    } else {
+      // node_pass's first test, with the box's nearest end and farthest start.
+      const double far = farthest_in(s.state.pose.position, box.lo, box.hi);
+      const double gap = nearest_in(s.proposed.pose.position, box.lo, box.hi) -
+                         (box.moved + shift_[i] + turn_[i] * far);
+      const double radius = s.geometry.bounding_radius() + offset;
+      reach = gap <= radius + kBroadSlack * (radius + far + shift_[i]);
+    }
+    if (reach) near |= solid_bit(i);
+  }
+  return near;
+}
+
+void Contact::refresh_boxes(const Field<Vec3>& current, const Field<Vec3>& next) {
+#pragma omp parallel for schedule(static)
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int i = 0; i < tiles_k_; ++i) {
+      const std::size_t t = tile(i, j);
+      if (!stale_[t]) continue;
+      const TileRange r = tile_nodes(i, j);
+      Box box{kEmptyLow, kEmptyHigh, 0.0};
+      double moved2 = 0.0;
+      for (int l = r.l0; l < r.l1; ++l)
+        for (int k = r.k0; k < r.k1; ++k) {
+          widen(box.lo, box.hi, current(k, l));
+          widen(box.lo, box.hi, next(k, l));
+          const Vec3 d = next(k, l) - current(k, l);
+          moved2 = std::max(moved2, dot(d, d));
+        }
+      box.moved = std::sqrt(moved2);
+      boxes_[t] = box;
+      near_[t] = near_solids(box);
+      stale_[t] = 0;
+    }
+}
+
+// A tile's velocities before the response moves any of its nodes.
+void Contact::prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next) {
+  const std::size_t t = tile(i, j);
+  if (ready_[t]) return;
+  const TileRange r = tile_nodes(i, j);
+  for (int l = r.l0; l < r.l1; ++l)
+    for (int k = r.k0; k < r.k1; ++k) {
+      velocity_(k, l) = next_velocities_ ? (*next_velocities_)(k, l)
+                                         : (next(k, l) - current(k, l)) / dt_;
+      touched_(k, l) = 0;
+    }
+  ready_[t] = 1;
+}
+
 // CONTACT.md §2, nodes: the segment from the node at the start of the step to its proposed end,
 // each end in the solid's frame at its own time, against the solid inflated by `thickness`.
 // An end inside goes to the nearest point of the inflated surface; an end beyond a thin solid
@@ -298,64 +429,80 @@ void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const
 // Solids in scene order, each seeing the node where the ones before it put it.
 void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                         std::vector<Exchange>& out) {
-  const Block& b = *block_;
-  std::vector<std::vector<Exchange>> rows(static_cast<std::size_t>(b.owned_l()));
 #pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l) {
-    std::vector<Exchange>& row = rows[static_cast<std::size_t>(l - b.l0)];
-    for (int k = b.k0; k < b.k1; ++k)
-      for (std::size_t i = 0; i < solids_.size(); ++i) {
-        const Solid& s = solids_[i];
-        const SolidGeometry& g = s.geometry;
-        const double offset = s.spec.thickness;
-        // A segment that stays outside the ball holding a bounded solid cannot touch it: first
-        // in world coordinates, then in the solid's frame.
-        // The path in the frame is at most the node's own, plus the frame's shift, plus its
-        // turn times the node's distance from the frame's origin (a chord is shorter than its
-        // arc).
-        const Vec3 world_end = next(k, l);
-        const Vec3 world_start = current(k, l);
-        const double path_bound = norm(world_end - world_start) + shift_[i] +
-                                  turn_[i] * norm(world_start - s.state.pose.position);
-        if (norm(world_end - s.proposed.pose.position) - path_bound > g.bounding_radius() + offset)
-          continue;
-        const Vec3 end = s.proposed.pose.to_local(world_end);
-        const Vec3 start = s.state.pose.to_local(current(k, l));
-        const Vec3 path = end - start;
-        if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
-        const Closest at_end = g.closest(end);
-        Vec3 target, normal;
-        if (at_end.distance < offset) {
-          normal = at_end.normal;
-          target = end + (offset - at_end.distance) * normal;
-        } else {
-          // Both ends outside: only a segment crossing a bounded solid can touch it.
-          if (s.spec.shape.kind == ShapeKind::plane) continue;
-          if (g.closest(start).distance < offset) continue;  // leaving, not entering
-          const std::optional<double> t = g.first_contact(start, end, offset);
-          if (!t) continue;
-          const Vec3 entry = start + *t * path;
-          normal = g.closest(entry).normal;
-          // A node leaving the offset surface it rested on meets it at t = 0 when round-off
-          // puts its start a hair outside: it is not entering. Put back on the tangent plane,
-          // it stayed glued to a box's side face while its velocity grew without bound.
-          if (dot(path, normal) >= 0.0) continue;
-          target = end - dot(end - entry, normal) * normal;
+  for (int j = 0; j < tiles_l_; ++j) {
+    std::vector<Exchange>& row = exchange_rows_[static_cast<std::size_t>(j)];
+    row.clear();
+    for (int ti = 0; ti < tiles_k_; ++ti) {
+      const std::size_t here = tile(ti, j);
+      const std::uint64_t near = near_[here];
+      if (near == 0) continue;
+      prepare(ti, j, current, next);
+      const TileRange range = tile_nodes(ti, j);
+      for (int l = range.l0; l < range.l1; ++l)
+        for (int k = range.k0; k < range.k1; ++k) {
+          // The tile's box says which solids its nodes can meet; a node one of them moved can
+          // meet any of the later ones.
+          bool moved = false;
+          for (std::size_t i = 0; i < solids_.size(); ++i) {
+            if (!moved && !(near & solid_bit(i))) continue;
+            const Solid& s = solids_[i];
+            const SolidGeometry& g = s.geometry;
+            const double offset = s.spec.thickness;
+            // A segment that stays outside the ball holding a bounded solid cannot touch it:
+            // first in world coordinates, then in the solid's frame. The path in the frame is
+            // at most the node's own, plus the frame's shift, plus its turn times the node's
+            // distance from the frame's origin (a chord is shorter than its arc).
+            const Vec3 world_end = next(k, l);
+            const Vec3 world_start = current(k, l);
+            const double path_bound = norm(world_end - world_start) + shift_[i] +
+                                      turn_[i] * norm(world_start - s.state.pose.position);
+            if (norm(world_end - s.proposed.pose.position) - path_bound >
+                g.bounding_radius() + offset)
+              continue;
+            const Vec3 end = s.proposed.pose.to_local(world_end);
+            const Vec3 start = s.state.pose.to_local(current(k, l));
+            const Vec3 path = end - start;
+            if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
+            const Closest at_end = g.closest(end);
+            Vec3 target, normal;
+            if (at_end.distance < offset) {
+              normal = at_end.normal;
+              target = end + (offset - at_end.distance) * normal;
+            } else {
+              // Both ends outside: only a segment crossing a bounded solid can touch it.
+              if (s.spec.shape.kind == ShapeKind::plane) continue;
+              if (g.closest(start).distance < offset) continue;  // leaving, not entering
+              const std::optional<double> t = g.first_contact(start, end, offset);
+              if (!t) continue;
+              const Vec3 entry = start + *t * path;
+              normal = g.closest(entry).normal;
+              // A node leaving the offset surface it rested on meets it at t = 0 when
+              // round-off puts its start a hair outside: it is not entering. Put back on the
+              // tangent plane, it stayed glued to a box's side face while its velocity grew
+              // without bound.
+              if (dot(path, normal) >= 0.0) continue;
+              target = end - dot(end - entry, normal) * normal;
+            }
+            Vec3& r = next(k, l);
+            const Vec3 r_before = r;
+            const Vec3 v_before = velocity_(k, l);
+            const Vec3 point = s.proposed.pose.to_world(target);
+            const Vec3 n = s.proposed.pose.direction_to_world(normal);
+            const Vec3 surface = surface_velocity(s.proposed, point);
+            const Vec3 change = velocity_change(s, surface, n, v_before);
+            r = point + slip_correction(change, n);
+            velocity_(k, l) = v_before + change;
+            remember(s, k, l, n, surface, v_before);
+            record(i, pass, 0, k, l, r_before, v_before, r, row);
+            moved = true;
+            stale_[here] = 1;
+            tile_touched_[here] = 1;
+          }
         }
-        Vec3& r = next(k, l);
-        const Vec3 r_before = r;
-        const Vec3 v_before = velocity_(k, l);
-        const Vec3 point = s.proposed.pose.to_world(target);
-        const Vec3 n = s.proposed.pose.direction_to_world(normal);
-        const Vec3 surface = surface_velocity(s.proposed, point);
-        const Vec3 change = velocity_change(s, surface, n, v_before);
-        r = point + slip_correction(change, n);
-        velocity_(k, l) = v_before + change;
-        remember(s, k, l, n, surface, v_before);
-        record(i, pass, 0, k, l, r_before, v_before, r, row);
-      }
+    }
   }
-  for (const auto& row : rows) out.insert(out.end(), row.begin(), row.end());
+  for (const auto& row : exchange_rows_) out.insert(out.end(), row.begin(), row.end());
 }
 
 // CONTACT.md §2, between nodes: each triangle of a cell (diagonal from (k, l) to (k+1, l+1))
@@ -386,25 +533,73 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const bool convex = s.spec.shape.kind != ShapeKind::mesh;
   halo_->exchange(next);
   halo_->exchange(velocity_);
-  // Cells (kc, lc), kc in [k0 − 1, k1), lc in [l0 − 1, l1), those inside the grid; their nodes
-  // are [k0 − 1, k1] x [l0 − 1, l1].
-  const int kc0 = std::max(b.k0 - 1, 0), kc1 = std::min(b.k1, b.m - 1);
-  const int lc0 = std::max(b.l0 - 1, 0), lc1 = std::min(b.l1, b.n - 1);
+  refresh_boxes(current, next);
+  // The broad phase: a tile's cells are visited only when the box of their nodes (the tile's
+  // box and its next neighbours', ghosts added) comes closer to the ball holding the solid than
+  // half the thickness plus the box's diagonal, which bounds every edge of those cells: the
+  // per-triangle test below skips a triangle farther away than its longest edge plus that.
+  const Vec3& centre = s.proposed.pose.position;
+#pragma omp parallel for schedule(static)
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int i = 0; i < tiles_k_; ++i) {
+      const TileRange c = tile_cell_nodes(i, j);
+      Vec3 lo = kEmptyLow, hi = kEmptyHigh;
+      for (int dj = 0; dj < 2 && j + dj < tiles_l_; ++dj)
+        for (int di = 0; di < 2 && i + di < tiles_k_; ++di) {
+          const Box& box = boxes_[tile(i + di, j + dj)];
+          widen(lo, hi, box.lo);
+          widen(lo, hi, box.hi);
+        }
+      const auto ghost = [&](int k, int l) {
+        if (!b.owns(k, l)) widen(lo, hi, next(k, l));
+      };
+      if (c.k0 < b.k0 || c.k1 >= b.k1)
+        for (int l = c.l0; l <= c.l1; ++l) {
+          ghost(c.k0, l);
+          ghost(c.k1, l);
+        }
+      if (c.l0 < b.l0 || c.l1 >= b.l1)
+        for (int k = c.k0; k <= c.k1; ++k) {
+          ghost(k, c.l0);
+          ghost(k, c.l1);
+        }
+      const double gap = nearest_in(centre, lo, hi) - radius - norm(hi - lo);
+      cells_near_[tile(i, j)] =
+          c.k1 > c.k0 && c.l1 > c.l0 &&
+          gap < flat_offset + kBroadSlack * (radius + farthest_in(centre, lo, hi));
+    }
+  // Whether a tile's nodes belong to a visited cell: its own cells, or those of the tiles
+  // before it.
+  const auto near_node_tile = [&](int i, int j) {
+    for (int dj = -1; dj <= 0; ++dj)
+      for (int di = -1; di <= 0; ++di)
+        if (i + di >= 0 && j + dj >= 0 && cells_near_[tile(i + di, j + dj)]) return true;
+    return false;
+  };
   // A lower bound of each node's signed distance: the distance itself near the solid, the
   // distance to its bounding ball farther out. The distance is 1-Lipschitz, so a triangle
   // whose nodes are all farther than its longest edge plus the offset cannot be pressed in.
+  // Each node of a visited cell is found by one tile: its own, a ghost by a border tile.
 #pragma omp parallel for schedule(static)
-  for (int l = lc0; l <= lc1; ++l)
-    for (int k = kc0; k <= kc1; ++k) {
-      const double outside_ball = norm(next(k, l) - s.proposed.pose.position) - radius;
-      if (outside_ball > thickness) {
-        distance_(k, l) = outside_ball;
-        normal_(k, l) = {};
-      } else {
-        const Closest c = g.closest(s.proposed.pose.to_local(next(k, l)));
-        distance_(k, l) = c.distance;
-        normal_(k, l) = c.normal;
-      }
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int i = 0; i < tiles_k_; ++i) {
+      if (!near_node_tile(i, j)) continue;
+      prepare(i, j, current, next);
+      const TileRange t = tile_nodes(i, j), c = tile_cell_nodes(i, j);
+      const int ka = i == 0 ? c.k0 : t.k0, kb = i == tiles_k_ - 1 ? c.k1 : t.k1 - 1;
+      const int la = j == 0 ? c.l0 : t.l0, lb = j == tiles_l_ - 1 ? c.l1 : t.l1 - 1;
+      for (int l = la; l <= lb; ++l)
+        for (int k = ka; k <= kb; ++k) {
+          const double outside_ball = norm(next(k, l) - centre) - radius;
+          if (outside_ball > thickness) {
+            distance_(k, l) = outside_ball;
+            normal_(k, l) = {};
+          } else {
+            const Closest near = g.closest(s.proposed.pose.to_local(next(k, l)));
+            distance_(k, l) = near.distance;
+            normal_(k, l) = near.normal;
+          }
+        }
     }
   const int width = b.owned_k() + 1;
   const auto triangle = [&](int kc, int lc, int tri) {
@@ -413,84 +608,95 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   };
   if (slot_.size() != static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2)
     slot_.assign(static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2, -1);
-  std::vector<std::vector<CellPush>> rows(static_cast<std::size_t>(std::max(lc1 - lc0, 0)));
 #pragma omp parallel for schedule(static)
-  for (int lc = lc0; lc < lc1; ++lc)
-    for (int kc = kc0; kc < kc1; ++kc)
-      for (int tri = 0; tri < 2; ++tri) {
-        // Corners of the two triangles, ordered so that the grid's mirror (k, l) → (l, k)
-        // maps one triangle onto the other with its corners in the same order.
-        const std::array<std::array<int, 2>, 3> nodes =
-            tri == 0 ? std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}}
-                     : std::array<std::array<int, 2>, 3>{{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
-        double nearest = 1e300, longest = 0.0;
-        for (int v = 0; v < 3; ++v) {
-          nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
-          const auto& a = nodes[v];
-          const auto& b2 = nodes[(v + 1) % 3];
-          longest = std::max(longest, norm(next(b2[0], b2[1]) - next(a[0], a[1])));
-        }
-        if (nearest - longest >= flat_offset) continue;
-        std::array<Vec3, 3> p;
-        for (int v = 0; v < 3; ++v) p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
-        // The signed distance to a convex solid lies above its tangent plane at each node, so
-        // over the triangle it is at least d_v + min_j n_v·(p_j − p_v) for every node v: a
-        // cell resting on a face, all its nodes on the offset surface, is not tested further.
-        if (convex) {
-          double lower = -1e300;
-          for (int v = 0; v < 3; ++v) {
-            const Vec3 n = normal_(nodes[v][0], nodes[v][1]);
-            if (dot(n, n) == 0.0) continue;
-            double reach = 0.0;
-            for (int j = 0; j < 3; ++j) reach = std::min(reach, dot(n, p[j] - p[v]));
-            lower = std::max(lower, distance_(nodes[v][0], nodes[v][1]) + reach);
+  for (int j = 0; j < tiles_l_; ++j) {
+    std::vector<CellPush>& pushes = push_rows_[static_cast<std::size_t>(j)];
+    pushes.clear();
+    for (int i = 0; i < tiles_k_; ++i) {
+      if (!cells_near_[tile(i, j)]) continue;
+      const TileRange cells = tile_cell_nodes(i, j);
+      for (int lc = cells.l0; lc < cells.l1; ++lc)
+        for (int kc = cells.k0; kc < cells.k1; ++kc)
+          for (int tri = 0; tri < 2; ++tri) {
+            // Corners of the two triangles, ordered so that the grid's mirror (k, l) → (l, k)
+            // maps one triangle onto the other with its corners in the same order.
+            using Corners = std::array<std::array<int, 2>, 3>;
+            const Corners nodes = tri == 0 ? Corners{{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}}
+                                           : Corners{{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
+            double nearest = 1e300, longest = 0.0;
+            for (int v = 0; v < 3; ++v) {
+              nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
+              const auto& a = nodes[v];
+              const auto& b2 = nodes[(v + 1) % 3];
+              longest = std::max(longest, norm(next(b2[0], b2[1]) - next(a[0], a[1])));
+            }
+            if (nearest - longest >= flat_offset) continue;
+            std::array<Vec3, 3> p;
+            for (int v = 0; v < 3; ++v)
+              p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
+            // The signed distance to a convex solid lies above its tangent plane at each node,
+            // so over the triangle it is at least d_v + min_j n_v·(p_j − p_v) for every node v:
+            // a cell resting on a face, all its nodes on the offset surface, is not tested
+            // further.
+            if (convex) {
+              double lower = -1e300;
+              for (int v = 0; v < 3; ++v) {
+                const Vec3 n = normal_(nodes[v][0], nodes[v][1]);
+                if (dot(n, n) == 0.0) continue;
+                double reach = 0.0;
+                for (int q = 0; q < 3; ++q) reach = std::min(reach, dot(n, p[q] - p[v]));
+                lower = std::max(lower, distance_(nodes[v][0], nodes[v][1]) + reach);
+              }
+              if (lower >= flat_offset) continue;
+            }
+            const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
+            if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
+            const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
+            const Closest c = g.closest(point);
+            // A cylinder's side is curved (its normal radial); its caps and rims are not. A
+            // free body keeps the flat rule: with the allowance, a free sphere's exchange with a
+            // coarse sheet (9 x 9 on 1 m, sag 2 cm) lost angular momentum at 5e-10 of 2.7
+            // (tests/unit/test_contact.cpp, AFreeBodyAndTheSheetExchangeMomentumExactly), cause
+            // not found.
+            const bool curved = s.spec.motion != SolidMotion::free &&
+                                (s.spec.shape.kind != ShapeKind::cylinder || c.normal.z == 0.0);
+            const double offset = curved ? curved_offset(longest) : flat_offset;
+            if (c.distance >= offset) continue;
+            double depth = offset - c.distance;
+            Vec3 side = c.normal;
+            // The point's own path over the step, in the solid's frame at each end's time, says
+            // where it entered: a thin solid can pass through a cell in one step, or leave it
+            // across the solid's core, where the nearest surface can be any way. When the
+            // surface it entered through faces more than 60° away from the nearest one, it goes
+            // back out through the one it entered, as far as it takes to clear the solid.
+            Vec3 from;
+            for (int v = 0; v < 3; ++v)
+              from += w[v] * s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
+            if (const std::optional<double> t = g.first_contact(from, point, offset)) {
+              const Vec3 entered = g.closest(from + *t * (point - from)).normal;
+              if (dot(entered, c.normal) < 0.5) {
+                side = entered;
+                depth = clearance(g, point, side, offset);
+              }
+            }
+            const double squares = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+            const Vec3 normal = s.proposed.pose.direction_to_world(side);
+            Vec3 velocity;
+            for (int v = 0; v < 3; ++v)
+              velocity += w[v] * velocity_(nodes[v][0], nodes[v][1]);
+            CellPush push;
+            push.triangle = triangle(kc, lc, tri);
+            push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
+            push.normal = normal;
+            push.surface = surface_velocity(s.proposed, s.proposed.pose.to_world(point));
+            push.velocity_change = velocity_change(s, push.surface, normal, velocity);
+            push.move = depth * normal + slip_correction(push.velocity_change, normal);
+            pushes.push_back(push);
           }
-          if (lower >= flat_offset) continue;
-        }
-        const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
-        if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
-        const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
-        const Closest c = g.closest(point);
-        // A cylinder's side is curved (its normal radial); its caps and rims are not. A free
-        // body keeps the flat rule: with the allowance, a free sphere's exchange with a coarse
-        // sheet (9 x 9 on 1 m, sag 2 cm) lost angular momentum at 5e-10 of 2.7 (tests/unit/
-        // test_contact.cpp, AFreeBodyAndTheSheetExchangeMomentumExactly), cause not found.
-        const bool curved = s.spec.motion != SolidMotion::free &&
-                            (s.spec.shape.kind != ShapeKind::cylinder || c.normal.z == 0.0);
-        const double offset = curved ? curved_offset(longest) : flat_offset;
-        if (c.distance >= offset) continue;
-        double depth = offset - c.distance;
-        Vec3 side = c.normal;
-        // The point's own path over the step, in the solid's frame at each end's time, says
-        // where it entered: a thin solid can pass through a cell in one step, or leave it
-        // across the solid's core, where the nearest surface can be any way. When the surface
-        // it entered through faces more than 60° away from the nearest one, it goes back out
-        // through the one it entered, as far as it takes to clear the solid.
-        Vec3 from;
-        for (int v = 0; v < 3; ++v)
-          from += w[v] * s.state.pose.to_local(current(nodes[v][0], nodes[v][1]));
-        if (const std::optional<double> t = g.first_contact(from, point, offset)) {
-          const Vec3 entered = g.closest(from + *t * (point - from)).normal;
-          if (dot(entered, c.normal) < 0.5) {
-            side = entered;
-            depth = clearance(g, point, side, offset);
-          }
-        }
-        const double squares = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-        const Vec3 normal = s.proposed.pose.direction_to_world(side);
-        Vec3 velocity;
-        for (int v = 0; v < 3; ++v) velocity += w[v] * velocity_(nodes[v][0], nodes[v][1]);
-        CellPush push;
-        push.triangle = triangle(kc, lc, tri);
-        push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
-        push.normal = normal;
-        push.surface = surface_velocity(s.proposed, s.proposed.pose.to_world(point));
-        push.velocity_change = velocity_change(s, push.surface, normal, velocity);
-        push.move = depth * normal + slip_correction(push.velocity_change, normal);
-        rows[static_cast<std::size_t>(lc - lc0)].push_back(push);
-      }
+    }
+  }
   cells_.clear();
-  for (const auto& row : rows) cells_.insert(cells_.end(), row.begin(), row.end());
+  for (const auto& row : push_rows_) cells_.insert(cells_.end(), row.begin(), row.end());
   if (cells_.empty()) return;
   for (std::size_t i = 0; i < cells_.size(); ++i) slot_[cells_[i].triangle] = static_cast<int>(i);
   // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
@@ -499,60 +705,76 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   };
   static constexpr std::array<Around, 6> around{
       {{0, 0, 0, 0}, {0, 0, 1, 0}, {-1, 0, 0, 1}, {-1, -1, 0, 2}, {-1, -1, 1, 2}, {0, -1, 1, 1}}};
-  std::vector<std::vector<Exchange>> exchange_rows(static_cast<std::size_t>(b.owned_l()));
 #pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) {
-      // Each triangle asks its nodes for the whole move that clears it, so a node's pushes
-      // are averaged, not added: added, the up to six triangles of a node resting on a box's
-      // edge moved it up to six times too far, and the next step it fell back.
-      Vec3 move, dv, normal, surface;
-      int pushes = 0;
-      for (const Around& a : around) {
-        const int kc = k + a.dk, lc = l + a.dl;
-        if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
-        const int slot = slot_[triangle(kc, lc, a.tri)];
-        if (slot < 0) continue;
-        const CellPush& push = cells_[static_cast<std::size_t>(slot)];
-        const double weight = push.weights[static_cast<std::size_t>(a.corner)];
-        move += weight * push.move;
-        dv += weight * push.velocity_change;
-        normal += weight * push.normal;
-        surface += push.surface;
-        ++pushes;
-      }
-      if (pushes == 0 || dot(normal, normal) == 0.0) continue;
-      const double share = 1.0 / pushes;
-      Vec3& r = next(k, l);
-      const Vec3 r_before = r;
-      const Vec3 v_before = velocity_(k, l);
-      r += share * move;
-      velocity_(k, l) += share * dv;
-      remember(s, k, l, normal / norm(normal), share * surface, v_before);
-      record(solid, pass, 1, k, l, r_before, v_before, r,
-             exchange_rows[static_cast<std::size_t>(l - b.l0)]);
+  for (int j = 0; j < tiles_l_; ++j) {
+    std::vector<Exchange>& exchanges = exchange_rows_[static_cast<std::size_t>(j)];
+    exchanges.clear();
+    for (int i = 0; i < tiles_k_; ++i) {
+      if (!near_node_tile(i, j)) continue;
+      const TileRange range = tile_nodes(i, j);
+      for (int l = range.l0; l < range.l1; ++l)
+        for (int k = range.k0; k < range.k1; ++k) {
+          // Each triangle asks its nodes for the whole move that clears it, so a node's
+          // pushes are averaged, not added: added, the up to six triangles of a node resting
+          // on a box's edge moved it up to six times too far, and the next step it fell back.
+          Vec3 move, dv, normal, surface;
+          int pushes = 0;
+          for (const Around& a : around) {
+            const int kc = k + a.dk, lc = l + a.dl;
+            if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
+            const int slot = slot_[triangle(kc, lc, a.tri)];
+            if (slot < 0) continue;
+            const CellPush& push = cells_[static_cast<std::size_t>(slot)];
+            const double weight = push.weights[static_cast<std::size_t>(a.corner)];
+            move += weight * push.move;
+            dv += weight * push.velocity_change;
+            normal += weight * push.normal;
+            surface += push.surface;
+            ++pushes;
+          }
+          if (pushes == 0 || dot(normal, normal) == 0.0) continue;
+          const double share = 1.0 / pushes;
+          Vec3& r = next(k, l);
+          const Vec3 r_before = r;
+          const Vec3 v_before = velocity_(k, l);
+          r += share * move;
+          velocity_(k, l) += share * dv;
+          remember(s, k, l, normal / norm(normal), share * surface, v_before);
+          record(solid, pass, 1, k, l, r_before, v_before, r, exchanges);
+          stale_[tile(i, j)] = 1;
+          tile_touched_[tile(i, j)] = 1;
+        }
     }
+  }
   for (const CellPush& push : cells_) slot_[push.triangle] = -1;
-  for (const auto& row : exchange_rows) out.insert(out.end(), row.begin(), row.end());
+  for (const auto& row : exchange_rows_) out.insert(out.end(), row.begin(), row.end());
 }
 
 bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {
-  const Block& b = *block_;
   int inside = 0;
   double deepest = 0.0;
 #pragma omp parallel for schedule(static) reduction(max : inside, deepest)
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k)
-      for (const Solid& s : solids_) {
-        const double offset = s.spec.thickness;
-        if (norm(next(k, l) - s.proposed.pose.position) > s.geometry.bounding_radius() + offset)
-          continue;
-        const Vec3 p = s.proposed.pose.to_local(next(k, l));
-        const double d = s.geometry.closest(p).distance;
-        deepest = std::max(deepest, -d);
-        // Round-off of the projection onto the offset surface is not inside.
-        if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
-      }
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int ti = 0; ti < tiles_k_; ++ti) {
+      const std::uint64_t near = near_[tile(ti, j)];
+      if (near == 0) continue;
+      const TileRange range = tile_nodes(ti, j);
+      for (int l = range.l0; l < range.l1; ++l)
+        for (int k = range.k0; k < range.k1; ++k)
+          for (std::size_t i = 0; i < solids_.size(); ++i) {
+            if (!(near & solid_bit(i))) continue;
+            const Solid& s = solids_[i];
+            const double offset = s.spec.thickness;
+            if (norm(next(k, l) - s.proposed.pose.position) >
+                s.geometry.bounding_radius() + offset)
+              continue;
+            const Vec3 p = s.proposed.pose.to_local(next(k, l));
+            const double d = s.geometry.closest(p).distance;
+            deepest = std::max(deepest, -d);
+            // Round-off of the projection onto the offset surface is not inside.
+            if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
+          }
+    }
   penetration = std::max(penetration, deepest);
   int any = inside;
   MPI_Allreduce(&inside, &any, 1, MPI_INT, MPI_MAX, block_->comm);
@@ -575,13 +797,20 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
     shift_[i] = norm(s.proposed.pose.position - s.state.pose.position);
     turn_[i] = turn_angle(s.state.pose.orientation, s.proposed.pose.orientation);
   }
+  // One sweep over the owned nodes for each tile's box (refresh_boxes); the velocities only
+  // where the response can need them (prepare), and on the block's border tiles, which the
+  // cell pass's exchange sends to the neighbours' ghosts.
+  next_velocities_ = next_velocities;
 #pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) {
-      velocity_(k, l) =
-          next_velocities ? (*next_velocities)(k, l) : (next(k, l) - current(k, l)) / dt;
-      touched_(k, l) = 0;
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int i = 0; i < tiles_k_; ++i) {
+      const std::size_t t = tile(i, j);
+      stale_[t] = 1;
+      tile_touched_[t] = 0;
+      ready_[t] = 0;
+      if (i == 0 || j == 0 || i == tiles_k_ - 1 || j == tiles_l_ - 1) prepare(i, j, current, next);
     }
+  refresh_boxes(current, next);
 
   std::vector<Exchange> exchanges;
   ContactStats stats;
@@ -589,6 +818,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
     node_pass(pass, current, next, exchanges);
     for (std::size_t i = 0; i < solids_.size(); ++i)
       if (std::isfinite(solids_[i].geometry.bounding_radius())) cell_pass(pass, i, current, next, exchanges);
+    refresh_boxes(current, next);
     double penetration = 0.0;
     const bool inside = any_inside(next, penetration);
     stats.max_penetration = penetration;
@@ -599,12 +829,17 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
 
   if (any_free_) apply_impulses(exchanges);
   long local = 0;
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k)
-      if (touched_(k, l)) {
-        corrected.push_back({k, l, settled_velocity(k, l, current, next)});
-        ++local;
-      }
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int i = 0; i < tiles_k_; ++i) {
+      if (!tile_touched_[tile(i, j)]) continue;
+      const TileRange r = tile_nodes(i, j);
+      for (int l = r.l0; l < r.l1; ++l)
+        for (int k = r.k0; k < r.k1; ++k)
+          if (touched_(k, l)) {
+            corrected.push_back({k, l, settled_velocity(k, l, current, next)});
+            ++local;
+          }
+    }
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
   return stats;
 }

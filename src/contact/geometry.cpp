@@ -24,14 +24,6 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 // axis: any choice is a valid subgradient of the distance, and a fixed one keeps runs
 // repeatable.
 
-Closest plane_closest(const Vec3& p) { return {p.z, {0.0, 0.0, 1.0}}; }
-
-Closest sphere_closest(const Vec3& p, double radius) {
-  const double r = norm(p);
-  if (r == 0.0) return {-radius, {0.0, 0.0, 1.0}};
-  return {r - radius, p / r};
-}
-
 Closest box_closest(const Vec3& p, const Vec3& half) {
   const Vec3 q{std::abs(p.x) - half.x, std::abs(p.y) - half.y, std::abs(p.z) - half.z};
   const Vec3 outside{std::max(q.x, 0.0), std::max(q.y, 0.0), std::max(q.z, 0.0)};
@@ -557,6 +549,28 @@ Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const
   return clean(compass_refine(best, best_value, distance));
 }
 
+// The radius of the ball about the frame's origin that holds the shape.
+double ball_radius(const Shape& shape) {
+  switch (shape.kind) {
+    case ShapeKind::plane:
+      return kInfinity;
+    case ShapeKind::sphere:
+      return shape.radius;
+    case ShapeKind::box:
+      return norm(shape.half_extents);
+    case ShapeKind::cylinder:
+      return std::hypot(shape.radius, shape.half_length);
+    case ShapeKind::capsule:
+      return shape.half_length + shape.radius;
+    case ShapeKind::mesh: {
+      double radius = 0.0;
+      for (const Vec3& v : shape.mesh->vertices) radius = std::max(radius, norm(v));
+      return radius;
+    }
+  }
+  throw std::logic_error("ball_radius: unknown shape kind");
+}
+
 }  // namespace
 
 SolidGeometry::SolidGeometry(Shape shape) : shape_(std::move(shape)) {
@@ -589,18 +603,18 @@ SolidGeometry::SolidGeometry(Shape shape) : shape_(std::move(shape)) {
       tree_ = std::make_unique<MeshTree>(*shape_.mesh);
       break;
   }
+  bounding_radius_ = ball_radius(shape_);
 }
 
 SolidGeometry::~SolidGeometry() = default;
 SolidGeometry::SolidGeometry(SolidGeometry&&) noexcept = default;
 SolidGeometry& SolidGeometry::operator=(SolidGeometry&&) noexcept = default;
 
-Closest SolidGeometry::closest(const Vec3& p) const {
+Closest SolidGeometry::closest_other(const Vec3& p) const {
   switch (shape_.kind) {
     case ShapeKind::plane:
-      return plane_closest(p);
     case ShapeKind::sphere:
-      return sphere_closest(p, shape_.radius);
+      return closest(p);
     case ShapeKind::box:
       return box_closest(p, shape_.half_extents);
     case ShapeKind::cylinder:
@@ -696,27 +710,6 @@ std::array<double, 3> SolidGeometry::deepest_point(const Vec3& a, const Vec3& b,
     }
   }
   throw std::logic_error("SolidGeometry::deepest_point: unknown shape kind");
-}
-
-double SolidGeometry::bounding_radius() const {
-  switch (shape_.kind) {
-    case ShapeKind::plane:
-      return kInfinity;
-    case ShapeKind::sphere:
-      return shape_.radius;
-    case ShapeKind::box:
-      return norm(shape_.half_extents);
-    case ShapeKind::cylinder:
-      return std::hypot(shape_.radius, shape_.half_length);
-    case ShapeKind::capsule:
-      return shape_.half_length + shape_.radius;
-    case ShapeKind::mesh: {
-      double radius = 0.0;
-      for (const Vec3& v : shape_.mesh->vertices) radius = std::max(radius, norm(v));
-      return radius;
-    }
-  }
-  throw std::logic_error("SolidGeometry::bounding_radius: unknown shape kind");
 }
 
 Vec3 SolidGeometry::inertia_per_mass() const {

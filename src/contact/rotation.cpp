@@ -16,8 +16,6 @@ Quaternion operator*(const Quaternion& a, const Quaternion& b) {
           a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w};
 }
 
-Quaternion conjugate(const Quaternion& q) { return {q.w, -q.x, -q.y, -q.z}; }
-
 Quaternion normalized(const Quaternion& q) {
   const double length = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
   if (!(length > 0.0) || !std::isfinite(length)) {
@@ -55,12 +53,6 @@ Quaternion rotation_between(const Vec3& a, const Vec3& b) {
                      : (std::abs(a.y) <= std::abs(a.z) ? Vec3{0.0, 1.0, 0.0} : Vec3{0.0, 0.0, 1.0});
   const Vec3 axis = cross(a, e);
   return from_axis_angle(axis, std::numbers::pi);
-}
-
-Vec3 rotate(const Quaternion& q, const Vec3& v) {
-  const Vec3 u{q.x, q.y, q.z};
-  const Vec3 t = 2.0 * cross(u, v);
-  return v + q.w * t + cross(u, t);
 }
 
 }  // namespace cosserat

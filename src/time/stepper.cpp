@@ -49,8 +49,9 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
   if (auto solver_failure = scheme_->advance(step_)) {
     return Instability{step_ + 1, end_time, -1, -1, false, std::move(solver_failure), {}};
   }
+  set_velocities_.clear();
   ProposedStep proposed{step_ + 1, dt, scheme_->positions(), scheme_->next_positions(),
-                        scheme_->next_velocities(), time_, {}};
+                        scheme_->next_velocities(), time_, set_velocities_};
   for (const auto& action : actions_) action->apply(proposed);
   // The check compares each node's move with its neighbours', across block borders too; the
   // accepted positions are then where the next step's forces are read.

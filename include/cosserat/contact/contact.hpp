@@ -5,6 +5,7 @@
 // decomposition, so every rank moves every body identically.
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "cosserat/contact/geometry.hpp"
@@ -77,6 +78,26 @@ class Contact {
   struct Exchange;
   // A cell triangle's correction (see cell_pass).
   struct CellPush;
+  // Where a tile's nodes are (see the broad phase in contact.cpp).
+  struct Box {
+    Vec3 lo, hi;
+    double moved = 0.0;  // the largest move of a node over the step
+  };
+  // The owned nodes in square tiles of kTile; tile (i, j) holds k in k0 + kTile [i, i + 1).
+  static constexpr int kTile = 8;
+  struct TileRange {
+    int k0, k1, l0, l1;
+  };
+  TileRange tile_nodes(int i, int j) const;
+  // The nodes of the cells tile (i, j) answers for, ghosts included, inclusive bounds.
+  TileRange tile_cell_nodes(int i, int j) const;
+  std::size_t tile(int i, int j) const { return static_cast<std::size_t>(i + j * tiles_k_); }
+  // The solids (bit i) node_pass must test for a tile's nodes, from their box.
+  std::uint64_t near_solids(const Box& box) const;
+  // Recomputes the box of every tile whose nodes moved since it was made.
+  void refresh_boxes(const Field<Vec3>& current, const Field<Vec3>& next);
+  // Sets a tile's velocities from the proposed step, once a response.
+  void prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
 
   void propose_free(Solid& s, double dt) const;
   Vec3 velocity_change(const Solid& s, const Vec3& surface, const Vec3& normal,
@@ -119,6 +140,16 @@ class Contact {
   Field<Vec3> normal_;             // and the normal there (solid's frame), zero when far
   std::vector<CellPush> cells_;    // cell_pass: the triangles pressed in
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
+  int tiles_k_ = 0, tiles_l_ = 0;
+  std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
+  std::vector<std::uint64_t> near_;          // per tile: near_solids(its box)
+  std::vector<unsigned char> stale_;         // per tile: a node moved since its box was made
+  std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
+  std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
+  std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
+  const Field<Vec3>* next_velocities_ = nullptr;  // of the step being proposed, or null
+  std::vector<std::vector<Exchange>> exchange_rows_;  // per tile row, reused step to step
+  std::vector<std::vector<CellPush>> push_rows_;
 };
 
 }  // namespace cosserat

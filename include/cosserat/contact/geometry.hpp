@@ -20,7 +20,7 @@ struct Quaternion {
   double z = 0.0;
 };
 Quaternion operator*(const Quaternion& a, const Quaternion& b);
-Quaternion conjugate(const Quaternion& q);
+inline Quaternion conjugate(const Quaternion& q) { return {q.w, -q.x, -q.y, -q.z}; }
 Quaternion normalized(const Quaternion& q);
 // The rotation by `angle` radians about `axis` (normalised here; any length > 0).
 Quaternion from_axis_angle(const Vec3& axis, double angle);
@@ -28,7 +28,12 @@ Quaternion from_axis_angle(const Vec3& axis, double angle);
 Quaternion from_rotation_vector(const Vec3& rotation);
 // The shortest rotation taking unit vector a to unit vector b.
 Quaternion rotation_between(const Vec3& a, const Vec3& b);
-Vec3 rotate(const Quaternion& q, const Vec3& v);
+// Inline: contact rotates every node it tests into each solid's frame.
+inline Vec3 rotate(const Quaternion& q, const Vec3& v) {
+  const Vec3 u{q.x, q.y, q.z};
+  const Vec3 t = 2.0 * cross(u, v);
+  return v + q.w * t + cross(u, t);
+}
 
 // Where a solid's frame sits: world = position + R(orientation) local.
 struct Pose {
@@ -90,7 +95,16 @@ class SolidGeometry {
 
   const Shape& shape() const { return shape_; }
 
-  Closest closest(const Vec3& p) const;
+  // Inline for the plane and the sphere: contact asks it of every node it tests.
+  Closest closest(const Vec3& p) const {
+    if (shape_.kind == ShapeKind::plane) return {p.z, {0.0, 0.0, 1.0}};
+    if (shape_.kind == ShapeKind::sphere) {
+      const double r = norm(p);
+      if (r == 0.0) return {-shape_.radius, {0.0, 0.0, 1.0}};
+      return {r - shape_.radius, p / r};
+    }
+    return closest_other(p);
+  }
 
   // Continuous detection (CONTACT.md §2): the smallest t in [0, 1] at which a + t (b − a)
   // is within `offset` of the shape (t = 0 when a already is), or nothing.
@@ -103,7 +117,7 @@ class SolidGeometry {
 
   // The radius of a ball about the frame's origin that holds the shape (infinite for a plane):
   // lets detection skip nodes far away cheaply.
-  double bounding_radius() const;
+  double bounding_radius() const { return bounding_radius_; }
 
   // Principal moments of inertia per unit mass, about the origin along the frame's axes, of a
   // solid of uniform density. Not for plane or mesh (throws std::logic_error).
@@ -115,7 +129,9 @@ class SolidGeometry {
 
  private:
   struct MeshTree;
+  Closest closest_other(const Vec3& p) const;  // the box, cylinder, capsule and mesh
   Shape shape_;
+  double bounding_radius_ = 0.0;
   std::unique_ptr<MeshTree> tree_;  // mesh only
 };
 

@@ -37,8 +37,10 @@ struct ProposedStep {
   Field<Vec3>* next_velocities;  // null for schemes that carry r⁻ instead (see Scheme)
   double time = 0.0;             // at the step's start
   // Nodes whose velocity an action set (a contact response): the scheme carries these into
-  // its next step, whether it holds velocities or r⁻ (Scheme::set_velocities).
-  std::vector<NodeVelocity> velocities;
+  // its next step, whether it holds velocities or r⁻ (Scheme::set_velocities). The stepper's,
+  // emptied for each step: a contact scene sets up to every node's, and allocating them every
+  // step cost more than the response itself.
+  std::vector<NodeVelocity>& velocities;
 };
 
 // Something done on every step whatever the scheme (a contact response, a step-size choice):
@@ -129,6 +131,7 @@ class Stepper {
   double time_ = 0.0;
   std::unique_ptr<Scheme> scheme_;
   std::vector<std::unique_ptr<StepAction>> actions_;
+  std::vector<NodeVelocity> set_velocities_;  // ProposedStep::velocities
 };
 
 }  // namespace cosserat
