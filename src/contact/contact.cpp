@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <utility>
 
 namespace cosserat {
@@ -104,7 +105,8 @@ Vec3 inertia_solve(const Quaternion& q, const Vec3& moments, const Vec3& x) {
 // CONTACT.md §3: the velocity a node leaves with, from its velocity v relative to a surface
 // moving at `surface`, with outward normal n: v_n' = −e v_n when approaching, Coulomb
 // friction |Δv_t| ≤ μ |Δv_n|, sticking when that suffices.
-Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double e, double mu) {
+[[gnu::always_inline]] inline Vec3 respond_velocity(const Vec3& v, const Vec3& surface,
+                                                    const Vec3& n, double e, double mu) {
   const Vec3 relative = v - surface;
   const double vn = dot(relative, n);
   if (vn >= 0.0) return v;
@@ -118,7 +120,7 @@ Vec3 respond_velocity(const Vec3& v, const Vec3& surface, const Vec3& n, double 
 
 
 // The velocity of a solid's surface at world point x.
-Vec3 surface_velocity(const SolidState& body, const Vec3& x) {
+[[gnu::always_inline]] inline Vec3 surface_velocity(const SolidState& body, const Vec3& x) {
   return body.velocity + cross(body.angular_velocity, x - body.pose.position);
 }
 
@@ -180,6 +182,40 @@ constexpr Vec3 kEmptyHigh{-kHuge, -kHuge, -kHuge};
 // (the frame's rotation), relative to the distances involved.
 constexpr double kBroadSlack = 1e-9;
 
+// The distance between two boxes.
+double box_gap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
+  const Vec3 d{std::max({alo.x - bhi.x, 0.0, blo.x - ahi.x}),
+               std::max({alo.y - bhi.y, 0.0, blo.y - ahi.y}),
+               std::max({alo.z - bhi.z, 0.0, blo.z - ahi.z})};
+  return norm(d);
+}
+
+// The box holding a bounded shape in its own frame (CONTACT.md §1's shapes).
+std::pair<Vec3, Vec3> local_bounds(const Shape& shape) {
+  const double r = shape.radius;
+  switch (shape.kind) {
+    case ShapeKind::sphere:
+      return {{-r, -r, -r}, {r, r, r}};
+    case ShapeKind::box:
+      return {-shape.half_extents, shape.half_extents};
+    case ShapeKind::cylinder:
+      return {{-r, -r, -shape.half_length}, {r, r, shape.half_length}};
+    case ShapeKind::capsule:
+      return {{-r, -r, -shape.half_length - r}, {r, r, shape.half_length + r}};
+    case ShapeKind::mesh: {
+      Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
+      for (const Vec3& v : shape.mesh->vertices) {
+        lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
+        hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
+      }
+      return {lo, hi};
+    }
+    case ShapeKind::plane:
+      break;
+  }
+  return {{-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge}};
+}
+
 // A solid's bit in a tile's mask: the 64th stands for every solid from the 64th on.
 std::uint64_t solid_bit(std::size_t i) { return std::uint64_t{1} << std::min<std::size_t>(i, 63); }
 
@@ -225,7 +261,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     const auto tiles = static_cast<std::size_t>(tiles_k_) * static_cast<std::size_t>(tiles_l_);
     boxes_.resize(tiles);
     near_.resize(tiles);
-    stale_.resize(tiles);
+    spare_.resize(tiles);
     tile_touched_.resize(tiles);
     cells_near_.resize(tiles);
     ready_.resize(tiles);
@@ -233,7 +269,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     push_rows_.resize(static_cast<std::size_t>(tiles_l_));
   }
   for (const SolidSpec& spec : solids) {
-    Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false};
+    Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false, {}, {}, {}, {}, {}};
     if (spec.motion == SolidMotion::free) {
       s.inertia_per_mass = s.geometry.inertia_per_mass();
       s.state = {spec.pose, spec.body.initial_velocity, spec.body.initial_angular_velocity};
@@ -246,6 +282,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     }
     s.proposed = s.state;
     s.proposed_pushing = s.pushing;
+    std::tie(s.local_lo, s.local_hi) = local_bounds(spec.shape);
     solids_.push_back(std::move(s));
   }
 }
@@ -360,52 +397,72 @@ Contact::TileRange Contact::tile_cell_nodes(int i, int j) const {
           j == tiles_l_ - 1 ? std::min(b.l1, b.n - 1) : t.l1};
 }
 
-std::uint64_t Contact::near_solids(const Box& box) const {
+// near_[t]: the solids a node of tile t can meet; spare_[t]: how far any of its nodes can
+// still be moved before it might meet one of the others (a move δ brings a node's end δ
+// closer to a solid and lengthens its path by δ: 2δ of each margin below).
+void Contact::classify(std::size_t t) {
+  const Box& box = boxes_[t];
   std::uint64_t near = 0;
+  double spare = kHuge;
   for (std::size_t i = 0; i < solids_.size(); ++i) {
     const Solid& s = solids_[i];
     const double offset = s.spec.thickness;
-    bool reach = true;
+    double margin = 0.0;
     if (s.spec.shape.kind == ShapeKind::plane) {
       // node_pass meets a plane only at an end closer to it than the offset.
-      const Vec3 n = s.proposed.pose.direction_to_world({0.0, 0.0, 1.0});
+      const Vec3& n = s.plane_normal;
       const Vec3& p = s.proposed.pose.position;
       const double lowest = lowest_along(n, box.lo, box.hi) - dot(n, p);
-      reach = lowest < offset + kBroadSlack * (offset + farthest_in(p, box.lo, box.hi));
+      margin = 2.0 * (lowest - offset - kBroadSlack * (offset + farthest_in(p, box.lo, box.hi)));
     } else {
-      // node_pass's first test, with the box's nearest end and farthest start.
+      // node_pass's first test, with the box's nearest end and farthest start; and the same
+      // against the box holding the solid: every point of a node's path in the solid's frame
+      // lies within that bound of its end, so a path that stays farther than the offset from
+      // the box meets nothing.
       const double far = farthest_in(s.state.pose.position, box.lo, box.hi);
-      const double gap = nearest_in(s.proposed.pose.position, box.lo, box.hi) -
-                         (box.moved + shift_[i] + turn_[i] * far);
+      const double path = box.moved + shift_[i] + turn_[i] * far;
+      const double gap = nearest_in(s.proposed.pose.position, box.lo, box.hi) - path;
       const double radius = s.geometry.bounding_radius() + offset;
-      reach = gap <= radius + kBroadSlack * (radius + far + shift_[i]);
+      const double slack = kBroadSlack * (radius + far + shift_[i]);
+      margin = std::max(gap - radius - slack,
+                        box_gap(box.lo, box.hi, s.reach_lo, s.reach_hi) - path - offset - slack);
     }
-    if (reach) near |= solid_bit(i);
+    if (margin > 0.0)
+      spare = std::min(spare, margin);
+    else
+      near |= solid_bit(i);
   }
-  return near;
+  near_[t] = near;
+  spare_[t] = 0.5 * spare;
 }
 
-void Contact::refresh_boxes(const Field<Vec3>& current, const Field<Vec3>& next) {
-#pragma omp parallel for schedule(static)
-  for (int j = 0; j < tiles_l_; ++j)
-    for (int i = 0; i < tiles_k_; ++i) {
-      const std::size_t t = tile(i, j);
-      if (!stale_[t]) continue;
-      const TileRange r = tile_nodes(i, j);
-      Box box{kEmptyLow, kEmptyHigh, 0.0};
-      double moved2 = 0.0;
-      for (int l = r.l0; l < r.l1; ++l)
-        for (int k = r.k0; k < r.k1; ++k) {
-          widen(box.lo, box.hi, current(k, l));
-          widen(box.lo, box.hi, next(k, l));
-          const Vec3 d = next(k, l) - current(k, l);
-          moved2 = std::max(moved2, dot(d, d));
-        }
-      box.moved = std::sqrt(moved2);
-      boxes_[t] = box;
-      near_[t] = near_solids(box);
-      stale_[t] = 0;
+// A tile's box from its nodes' positions at both ends of the proposed step.
+void Contact::make_box(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next) {
+  const TileRange r = tile_nodes(i, j);
+  Box box{kEmptyLow, kEmptyHigh, 0.0};
+  double moved2 = 0.0;
+  for (int l = r.l0; l < r.l1; ++l)
+    for (int k = r.k0; k < r.k1; ++k) {
+      const Vec3 start = current(k, l), end = next(k, l);
+      widen(box.lo, box.hi, start);
+      widen(box.lo, box.hi, end);
+      const Vec3 d = end - start;
+      moved2 = std::max(moved2, dot(d, d));
     }
+  box.moved = std::sqrt(moved2);
+  const std::size_t t = tile(i, j);
+  boxes_[t] = box;
+  classify(t);
+}
+
+// The response moved node (k, l) of tile t: its box grows to hold where it is now, so that it
+// still holds the node's every position over the step.
+void Contact::grow_box(std::size_t t, int k, int l, const Field<Vec3>& current,
+                       const Field<Vec3>& next) {
+  Box& box = boxes_[t];
+  widen(box.lo, box.hi, next(k, l));
+  box.moved = std::max(box.moved, norm(next(k, l) - current(k, l)));
+  tile_touched_[t] = 1;
 }
 
 // A tile's velocities before the response moves any of its nodes.
@@ -441,54 +498,65 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
       const TileRange range = tile_nodes(ti, j);
       for (int l = range.l0; l < range.l1; ++l)
         for (int k = range.k0; k < range.k1; ++k) {
-          // The tile's box says which solids its nodes can meet; a node one of them moved can
-          // meet any of the later ones.
+          // The tile's box says which solids its nodes can meet; a node one of them moved
+          // farther than the tile's spare can meet any of the later ones.
+          const Vec3 proposed = next(k, l);
+          const double spare = spare_[here];
           bool moved = false;
           for (std::size_t i = 0; i < solids_.size(); ++i) {
-            if (!moved && !(near & solid_bit(i))) continue;
+            if (!(near & solid_bit(i)) && !(moved && !(norm(next(k, l) - proposed) < spare)))
+              continue;
             const Solid& s = solids_[i];
             const SolidGeometry& g = s.geometry;
             const double offset = s.spec.thickness;
-            // A segment that stays outside the ball holding a bounded solid cannot touch it:
-            // first in world coordinates, then in the solid's frame. The path in the frame is
-            // at most the node's own, plus the frame's shift, plus its turn times the node's
-            // distance from the frame's origin (a chord is shorter than its arc).
             const Vec3 world_end = next(k, l);
             const Vec3 world_start = current(k, l);
-            const double path_bound = norm(world_end - world_start) + shift_[i] +
-                                      turn_[i] * norm(world_start - s.state.pose.position);
-            if (norm(world_end - s.proposed.pose.position) - path_bound >
-                g.bounding_radius() + offset)
-              continue;
-            const Vec3 end = s.proposed.pose.to_local(world_end);
-            const Vec3 start = s.state.pose.to_local(current(k, l));
-            const Vec3 path = end - start;
-            if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
-            const Closest at_end = g.closest(end);
-            Vec3 target, normal;
-            if (at_end.distance < offset) {
-              normal = at_end.normal;
-              target = end + (offset - at_end.distance) * normal;
+            Vec3 point, n;
+            if (s.spec.shape.kind == ShapeKind::plane) {
+              // A plane, in the world frame: only an end closer than the offset meets it.
+              n = s.plane_normal;
+              const double d = dot(world_end - s.proposed.pose.position, n);
+              if (d >= offset) continue;
+              point = world_end + (offset - d) * n;
             } else {
-              // Both ends outside: only a segment crossing a bounded solid can touch it.
-              if (s.spec.shape.kind == ShapeKind::plane) continue;
-              if (g.closest(start).distance < offset) continue;  // leaving, not entering
-              const std::optional<double> t = g.first_contact(start, end, offset);
-              if (!t) continue;
-              const Vec3 entry = start + *t * path;
-              normal = g.closest(entry).normal;
-              // A node leaving the offset surface it rested on meets it at t = 0 when
-              // round-off puts its start a hair outside: it is not entering. Put back on the
-              // tangent plane, it stayed glued to a box's side face while its velocity grew
-              // without bound.
-              if (dot(path, normal) >= 0.0) continue;
-              target = end - dot(end - entry, normal) * normal;
+              // A segment that stays outside the ball holding the solid cannot touch it: first
+              // in world coordinates, then in the solid's frame. The path in the frame is at
+              // most the node's own, plus the frame's shift, plus its turn times the node's
+              // distance from the frame's origin (a chord is shorter than its arc).
+              const double path_bound = norm(world_end - world_start) + shift_[i] +
+                                        turn_[i] * norm(world_start - s.state.pose.position);
+              if (norm(world_end - s.proposed.pose.position) - path_bound >
+                  g.bounding_radius() + offset)
+                continue;
+              const Vec3 end = s.proposed.pose.to_local(world_end);
+              const Vec3 start = s.state.pose.to_local(world_start);
+              const Vec3 path = end - start;
+              if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
+              const Closest at_end = g.closest(end);
+              Vec3 target, normal;
+              if (at_end.distance < offset) {
+                normal = at_end.normal;
+                target = end + (offset - at_end.distance) * normal;
+              } else {
+                // Both ends outside: only a segment crossing the solid can touch it.
+                if (g.closest(start).distance < offset) continue;  // leaving, not entering
+                const std::optional<double> t = g.first_contact(start, end, offset);
+                if (!t) continue;
+                const Vec3 entry = start + *t * path;
+                normal = g.closest(entry).normal;
+                // A node leaving the offset surface it rested on meets it at t = 0 when
+                // round-off puts its start a hair outside: it is not entering. Put back on the
+                // tangent plane, it stayed glued to a box's side face while its velocity grew
+                // without bound.
+                if (dot(path, normal) >= 0.0) continue;
+                target = end - dot(end - entry, normal) * normal;
+              }
+              point = s.proposed.pose.to_world(target);
+              n = s.proposed.pose.direction_to_world(normal);
             }
             Vec3& r = next(k, l);
             const Vec3 r_before = r;
             const Vec3 v_before = velocity_(k, l);
-            const Vec3 point = s.proposed.pose.to_world(target);
-            const Vec3 n = s.proposed.pose.direction_to_world(normal);
             const Vec3 surface = surface_velocity(s.proposed, point);
             const Vec3 change = velocity_change(s, surface, n, v_before);
             r = point + slip_correction(change, n);
@@ -496,10 +564,11 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
             remember(s, k, l, n, surface, v_before);
             record(i, pass, 0, k, l, r_before, v_before, r, row);
             moved = true;
-            stale_[here] = 1;
-            tile_touched_[here] = 1;
+            grow_box(here, k, l, current, next);
           }
         }
+      // Grown, the box may reach more solids.
+      if (tile_touched_[here]) classify(here);
     }
   }
   for (const auto& row : exchange_rows_) out.insert(out.end(), row.begin(), row.end());
@@ -533,7 +602,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const bool convex = s.spec.shape.kind != ShapeKind::mesh;
   halo_->exchange(next);
   halo_->exchange(velocity_);
-  refresh_boxes(current, next);
   // The broad phase: a tile's cells are visited only when the box of their nodes (the tile's
   // box and its next neighbours', ghosts added) comes closer to the ball holding the solid than
   // half the thickness plus the box's diagonal, which bounds every edge of those cells: the
@@ -563,10 +631,14 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           ghost(k, c.l0);
           ghost(k, c.l1);
         }
-      const double gap = nearest_in(centre, lo, hi) - radius - norm(hi - lo);
+      // A triangle that passes the per-triangle test farther from the solid's box than that
+      // finds its deepest point farther than the offset, and is not pressed in either.
+      const double diagonal = norm(hi - lo);
+      const double slack = kBroadSlack * (radius + farthest_in(centre, lo, hi));
       cells_near_[tile(i, j)] =
           c.k1 > c.k0 && c.l1 > c.l0 &&
-          gap < flat_offset + kBroadSlack * (radius + farthest_in(centre, lo, hi));
+          nearest_in(centre, lo, hi) - radius - diagonal < flat_offset + slack &&
+          box_gap(lo, hi, s.reach_lo, s.reach_hi) - diagonal < flat_offset + slack;
     }
   // Whether a tile's nodes belong to a visited cell: its own cells, or those of the tiles
   // before it.
@@ -741,9 +813,9 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           velocity_(k, l) += share * dv;
           remember(s, k, l, normal / norm(normal), share * surface, v_before);
           record(solid, pass, 1, k, l, r_before, v_before, r, exchanges);
-          stale_[tile(i, j)] = 1;
-          tile_touched_[tile(i, j)] = 1;
+          grow_box(tile(i, j), k, l, current, next);
         }
+      if (tile_touched_[tile(i, j)]) classify(tile(i, j));
     }
   }
   for (const CellPush& push : cells_) slot_[push.triangle] = -1;
@@ -765,11 +837,15 @@ bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {
             if (!(near & solid_bit(i))) continue;
             const Solid& s = solids_[i];
             const double offset = s.spec.thickness;
-            if (norm(next(k, l) - s.proposed.pose.position) >
-                s.geometry.bounding_radius() + offset)
-              continue;
-            const Vec3 p = s.proposed.pose.to_local(next(k, l));
-            const double d = s.geometry.closest(p).distance;
+            double d = 0.0;
+            if (s.spec.shape.kind == ShapeKind::plane) {
+              d = dot(next(k, l) - s.proposed.pose.position, s.plane_normal);
+            } else {
+              if (norm(next(k, l) - s.proposed.pose.position) >
+                  s.geometry.bounding_radius() + offset)
+                continue;
+              d = s.geometry.closest(s.proposed.pose.to_local(next(k, l))).distance;
+            }
             deepest = std::max(deepest, -d);
             // Round-off of the projection onto the offset surface is not inside.
             if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
@@ -796,21 +872,39 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
       s.proposed = kinematic_state(s.spec, time + dt);
     shift_[i] = norm(s.proposed.pose.position - s.state.pose.position);
     turn_[i] = turn_angle(s.state.pose.orientation, s.proposed.pose.orientation);
+    if (s.spec.shape.kind == ShapeKind::plane) {
+      s.plane_normal = s.proposed.pose.direction_to_world({0.0, 0.0, 1.0});
+    } else {
+      // The world box of the rotated local box: centre R c + p, half-widths |R| h.
+      const Pose& pose = s.proposed.pose;
+      const Vec3 centre = pose.to_world(0.5 * (s.local_lo + s.local_hi));
+      const Vec3 half = 0.5 * (s.local_hi - s.local_lo);
+      const Vec3 ex = pose.direction_to_world({1.0, 0.0, 0.0});
+      const Vec3 ey = pose.direction_to_world({0.0, 1.0, 0.0});
+      const Vec3 ez = pose.direction_to_world({0.0, 0.0, 1.0});
+      const auto reach = [&](double x, double y, double z) {
+        return std::abs(x) * half.x + std::abs(y) * half.y + std::abs(z) * half.z;
+      };
+      const Vec3 extent{reach(ex.x, ey.x, ez.x), reach(ex.y, ey.y, ez.y), reach(ex.z, ey.z, ez.z)};
+      s.reach_lo = centre - extent;
+      s.reach_hi = centre + extent;
+    }
   }
-  // One sweep over the owned nodes for each tile's box (refresh_boxes); the velocities only
-  // where the response can need them (prepare), and on the block's border tiles, which the
-  // cell pass's exchange sends to the neighbours' ghosts.
+  // One sweep over the owned nodes for each tile's box; the velocities only where the
+  // response can need them (prepare): on tiles a solid can reach, while their nodes are in
+  // cache, and on the block's border tiles, which the cell pass's exchange sends to the
+  // neighbours' ghosts.
   next_velocities_ = next_velocities;
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
       const std::size_t t = tile(i, j);
-      stale_[t] = 1;
       tile_touched_[t] = 0;
       ready_[t] = 0;
-      if (i == 0 || j == 0 || i == tiles_k_ - 1 || j == tiles_l_ - 1) prepare(i, j, current, next);
+      make_box(i, j, current, next);
+      if (near_[t] || i == 0 || j == 0 || i == tiles_k_ - 1 || j == tiles_l_ - 1)
+        prepare(i, j, current, next);
     }
-  refresh_boxes(current, next);
 
   std::vector<Exchange> exchanges;
   ContactStats stats;
@@ -818,7 +912,6 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
     node_pass(pass, current, next, exchanges);
     for (std::size_t i = 0; i < solids_.size(); ++i)
       if (std::isfinite(solids_[i].geometry.bounding_radius())) cell_pass(pass, i, current, next, exchanges);
-    refresh_boxes(current, next);
     double penetration = 0.0;
     const bool inside = any_inside(next, penetration);
     stats.max_penetration = penetration;

@@ -73,6 +73,9 @@ class Contact {
     SolidState proposed;    // at the end of the step being proposed
     bool pushing = false;   // free bodies: the constant push still acts
     bool proposed_pushing = false;
+    Vec3 local_lo, local_hi;    // bounded shapes: the box holding it in its frame
+    Vec3 reach_lo, reach_hi;    // and in the world at the proposed pose (the broad phase)
+    Vec3 plane_normal;          // a plane's world normal at the proposed pose
   };
   // One node's change by one solid, for a free body's sums (see contact.cpp).
   struct Exchange;
@@ -92,26 +95,32 @@ class Contact {
   // The nodes of the cells tile (i, j) answers for, ghosts included, inclusive bounds.
   TileRange tile_cell_nodes(int i, int j) const;
   std::size_t tile(int i, int j) const { return static_cast<std::size_t>(i + j * tiles_k_); }
-  // The solids (bit i) node_pass must test for a tile's nodes, from their box.
-  std::uint64_t near_solids(const Box& box) const;
-  // Recomputes the box of every tile whose nodes moved since it was made.
-  void refresh_boxes(const Field<Vec3>& current, const Field<Vec3>& next);
+  // Sets near_ and spare_ of tile t from its box.
+  void classify(std::size_t t);
+  void make_box(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
+  [[gnu::always_inline]] inline void grow_box(std::size_t t, int k, int l,
+                                              const Field<Vec3>& current,
+                                              const Field<Vec3>& next);
   // Sets a tile's velocities from the proposed step, once a response.
   void prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
 
   void propose_free(Solid& s, double dt) const;
-  Vec3 velocity_change(const Solid& s, const Vec3& surface, const Vec3& normal,
-                       const Vec3& velocity) const;
-  Vec3 slip_correction(const Vec3& change, const Vec3& normal) const;
+  // Inline, with remember() and settled_velocity(): run for every node in contact, their
+  // Vec3 arguments passed through memory cost more than their arithmetic.
+  [[gnu::always_inline]] inline Vec3 velocity_change(const Solid& s, const Vec3& surface,
+                                                     const Vec3& normal,
+                                                     const Vec3& velocity) const;
+  [[gnu::always_inline]] inline Vec3 slip_correction(const Vec3& change,
+                                                     const Vec3& normal) const;
   void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
   // Node (k, l) met solid s with world normal n, arriving at `velocity` against a surface
   // moving at `surface`: what settled_velocity() needs to make its velocity consistent.
-  void remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& surface,
-                const Vec3& velocity);
+  [[gnu::always_inline]] inline void remember(const Solid& s, int k, int l, const Vec3& n,
+                                              const Vec3& surface, const Vec3& velocity);
   // The velocity touched node (k, l) leaves with (docs/contact.md, "Velocities").
-  Vec3 settled_velocity(int k, int l, const Field<Vec3>& current,
-                        const Field<Vec3>& next) const;
+  [[gnu::always_inline]] inline Vec3 settled_velocity(int k, int l, const Field<Vec3>& current,
+                                                      const Field<Vec3>& next) const;
   void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                  std::vector<Exchange>& out);
   void cell_pass(int pass, std::size_t solid, const Field<Vec3>& current, Field<Vec3>& next,
@@ -142,8 +151,8 @@ class Contact {
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
   int tiles_k_ = 0, tiles_l_ = 0;
   std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
-  std::vector<std::uint64_t> near_;          // per tile: near_solids(its box)
-  std::vector<unsigned char> stale_;         // per tile: a node moved since its box was made
+  std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
+  std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
   std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
   std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
