@@ -196,6 +196,62 @@ inline Scene free_body_scene(Integrator integrator) {
   return scene;
 }
 
+// A sheet falling onto six solids of every bounded kind and a floor, two of them moving, each
+// reaching only part of the sheet: the contact broad phase (docs/contact.md, "Cost") clears
+// tiles of nodes by their bounds, and its tiles follow the blocks, so a tile cleared wrongly
+// would show as a difference between splits.
+inline Scene many_solids_scene() {
+  Scene scene = flat_sheet(29, 23);
+  scene.size1 = 1.4;
+  scene.size2 = 1.1;
+  scene.origin = {-0.7, 0.1, -0.55};
+  scene.material.mass = 0.25;
+  scene.material.zeta = {20.0, 0.0, 20.0};
+  scene.material.xi = {1e-3, 0.0, 1e-3};
+  scene.material.phi = {0.0, 0.0, 0.0};
+  scene.gravity = {0.0, -9.81, 0.0};
+  scene.integrator = Integrator::verlet;
+  scene.dt = 5e-4;
+  scene.steps = 400;
+  const auto solid = [&](ShapeKind kind, const Vec3& centre) {
+    SolidSpec s;
+    s.name = "solid " + std::to_string(scene.solids.size());
+    s.shape.kind = kind;
+    s.pose.position = centre;
+    s.friction = 0.3;
+    s.thickness = 3e-3;
+    return s;
+  };
+  SolidSpec floor = solid(ShapeKind::plane, {0.0, -0.05, 0.0});
+  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
+  scene.solids.push_back(floor);
+  SolidSpec ball = solid(ShapeKind::sphere, {-0.45, 0.0, -0.3});
+  ball.shape.radius = 0.08;
+  ball.motion = SolidMotion::kinematic;
+  ball.path.velocity = {1.2, 0.2, 0.4};
+  scene.solids.push_back(ball);
+  SolidSpec box = solid(ShapeKind::box, {0.3, 0.0, 0.25});
+  box.shape.half_extents = {0.1, 0.04, 0.06};
+  box.pose.orientation = from_axis_angle({0.3, 1.0, 0.2}, 0.7);
+  box.motion = SolidMotion::kinematic;
+  box.path.angular_velocity = {0.0, 4.0, 1.0};
+  scene.solids.push_back(box);
+  SolidSpec cylinder = solid(ShapeKind::cylinder, {-0.2, -0.02, 0.3});
+  cylinder.shape.radius = 0.07;
+  cylinder.shape.half_length = 0.05;
+  cylinder.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
+  scene.solids.push_back(cylinder);
+  SolidSpec capsule = solid(ShapeKind::capsule, {0.1, -0.01, -0.2});
+  capsule.shape.radius = 0.015;
+  capsule.shape.half_length = 0.35;
+  capsule.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {1.0, 0.0, 0.3});
+  scene.solids.push_back(capsule);
+  SolidSpec far = solid(ShapeKind::box, {0.0, 2.0, 0.0});
+  far.shape.half_extents = {0.2, 0.2, 0.2};
+  scene.solids.push_back(far);
+  return scene;
+}
+
 // Number of owned nodes, over all ranks, where `field` differs in any bit from `reference`,
 // a field of the whole grid.
 inline long differing_nodes(const Field<Vec3>& field, const Field<Vec3>& reference) {

@@ -303,5 +303,24 @@ TEST(DecompositionInvariance, ContactWithAFreeBodyFollowsTheOneBlockRun) {
   }
 }
 
+// The contact broad phase visits only tiles of nodes a solid can reach, tiles that follow the
+// blocks: with six solids, two moving, each reaching part of the sheet, every split still
+// follows the one-block run bitwise.
+TEST(DecompositionInvariance, ContactBroadPhaseFollowsTheOneBlockRun) {
+  const Scene scene = testing::many_solids_scene();
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(reference, scene.steps));
+  ASSERT_GT(reference.contact_summary().max_contacts, 0);
+  for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+    Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+    ASSERT_TRUE(testing::advance(sim, scene.steps));
+    EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+        << "split " << split_name(d);
+    EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+        << "split " << split_name(d);
+    EXPECT_EQ(sim.contact_summary().max_contacts, reference.contact_summary().max_contacts);
+  }
+}
+
 }  // namespace
 }  // namespace cosserat
