@@ -154,11 +154,12 @@ double clearance(const SolidGeometry& g, const Vec3& p, const Vec3& n, double of
   return outside;
 }
 
-// Box helpers of the broad phase: the nearest and farthest distance from p to a box, the
-// lowest value of n·x over it.
-double nearest_in(const Vec3& p, const Vec3& lo, const Vec3& hi) {
-  const Vec3 d{std::max({lo.x - p.x, 0.0, p.x - hi.x}), std::max({lo.y - p.y, 0.0, p.y - hi.y}),
-               std::max({lo.z - p.z, 0.0, p.z - hi.z})};
+// Box helpers of the broad phase: the distance between two boxes (a point is a box), the
+// farthest distance from p to a box, the lowest value of n·x over it.
+double box_gap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
+  const Vec3 d{std::max({alo.x - bhi.x, 0.0, blo.x - ahi.x}),
+               std::max({alo.y - bhi.y, 0.0, blo.y - ahi.y}),
+               std::max({alo.z - bhi.z, 0.0, blo.z - ahi.z})};
   return norm(d);
 }
 double farthest_in(const Vec3& p, const Vec3& lo, const Vec3& hi) {
@@ -182,14 +183,6 @@ constexpr Vec3 kEmptyHigh{-kHuge, -kHuge, -kHuge};
 // (the frame's rotation), relative to the distances involved.
 constexpr double kBroadSlack = 1e-9;
 
-// The distance between two boxes.
-double box_gap(const Vec3& alo, const Vec3& ahi, const Vec3& blo, const Vec3& bhi) {
-  const Vec3 d{std::max({alo.x - bhi.x, 0.0, blo.x - ahi.x}),
-               std::max({alo.y - bhi.y, 0.0, blo.y - ahi.y}),
-               std::max({alo.z - bhi.z, 0.0, blo.z - ahi.z})};
-  return norm(d);
-}
-
 // The box holding a bounded shape in its own frame (CONTACT.md §1's shapes).
 std::pair<Vec3, Vec3> local_bounds(const Shape& shape) {
   const double r = shape.radius;
@@ -203,17 +196,14 @@ std::pair<Vec3, Vec3> local_bounds(const Shape& shape) {
     case ShapeKind::capsule:
       return {{-r, -r, -shape.half_length - r}, {r, r, shape.half_length + r}};
     case ShapeKind::mesh: {
-      Vec3 lo{kHuge, kHuge, kHuge}, hi{-kHuge, -kHuge, -kHuge};
-      for (const Vec3& v : shape.mesh->vertices) {
-        lo = {std::min(lo.x, v.x), std::min(lo.y, v.y), std::min(lo.z, v.z)};
-        hi = {std::max(hi.x, v.x), std::max(hi.y, v.y), std::max(hi.z, v.z)};
-      }
+      Vec3 lo = kEmptyLow, hi = kEmptyHigh;
+      for (const Vec3& v : shape.mesh->vertices) widen(lo, hi, v);
       return {lo, hi};
     }
     case ShapeKind::plane:
       break;
   }
-  return {{-kHuge, -kHuge, -kHuge}, {kHuge, kHuge, kHuge}};
+  return {kEmptyHigh, kEmptyLow};
 }
 
 // A solid's bit in a tile's mask: the 64th stands for every solid from the 64th on.
@@ -421,7 +411,8 @@ void Contact::classify(std::size_t t) {
       // the box meets nothing.
       const double far = farthest_in(s.state.pose.position, box.lo, box.hi);
       const double path = box.moved + shift_[i] + turn_[i] * far;
-      const double gap = nearest_in(s.proposed.pose.position, box.lo, box.hi) - path;
+      const Vec3& centre = s.proposed.pose.position;
+      const double gap = box_gap(centre, centre, box.lo, box.hi) - path;
       const double radius = s.geometry.bounding_radius() + offset;
       const double slack = kBroadSlack * (radius + far + shift_[i]);
       margin = std::max(gap - radius - slack,
@@ -496,12 +487,13 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
       if (near == 0) continue;
       prepare(ti, j, current, next);
       const TileRange range = tile_nodes(ti, j);
+      const double spare = spare_[here];
+      bool grew = false;
       for (int l = range.l0; l < range.l1; ++l)
         for (int k = range.k0; k < range.k1; ++k) {
           // The tile's box says which solids its nodes can meet; a node one of them moved
           // farther than the tile's spare can meet any of the later ones.
           const Vec3 proposed = next(k, l);
-          const double spare = spare_[here];
           bool moved = false;
           for (std::size_t i = 0; i < solids_.size(); ++i) {
             if (!(near & solid_bit(i)) && !(moved && !(norm(next(k, l) - proposed) < spare)))
@@ -563,12 +555,12 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
             velocity_(k, l) = v_before + change;
             remember(s, k, l, n, surface, v_before);
             record(i, pass, 0, k, l, r_before, v_before, r, row);
-            moved = true;
+            moved = grew = true;
             grow_box(here, k, l, current, next);
           }
         }
       // Grown, the box may reach more solids.
-      if (tile_touched_[here]) classify(here);
+      if (grew) classify(here);
     }
   }
   for (const auto& row : exchange_rows_) out.insert(out.end(), row.begin(), row.end());
@@ -637,7 +629,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       const double slack = kBroadSlack * (radius + farthest_in(centre, lo, hi));
       cells_near_[tile(i, j)] =
           c.k1 > c.k0 && c.l1 > c.l0 &&
-          nearest_in(centre, lo, hi) - radius - diagonal < flat_offset + slack &&
+          box_gap(centre, centre, lo, hi) - radius - diagonal < flat_offset + slack &&
           box_gap(lo, hi, s.reach_lo, s.reach_hi) - diagonal < flat_offset + slack;
     }
   // Whether a tile's nodes belong to a visited cell: its own cells, or those of the tiles
@@ -784,6 +776,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
     for (int i = 0; i < tiles_k_; ++i) {
       if (!near_node_tile(i, j)) continue;
       const TileRange range = tile_nodes(i, j);
+      bool grew = false;
       for (int l = range.l0; l < range.l1; ++l)
         for (int k = range.k0; k < range.k1; ++k) {
           // Each triangle asks its nodes for the whole move that clears it, so a node's
@@ -814,8 +807,9 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           remember(s, k, l, normal / norm(normal), share * surface, v_before);
           record(solid, pass, 1, k, l, r_before, v_before, r, exchanges);
           grow_box(tile(i, j), k, l, current, next);
+          grew = true;
         }
-      if (tile_touched_[tile(i, j)]) classify(tile(i, j));
+      if (grew) classify(tile(i, j));
     }
   }
   for (const CellPush& push : cells_) slot_[push.triangle] = -1;

@@ -159,16 +159,23 @@ inline Scene gusty_rolling_back_scene(Integrator integrator) {
 // thrown down onto it off-centre and spinning, a fixed sphere under the sheet whose cells it
 // presses into, and a floor; 160 steps of 1 ms, long enough for both solids to touch the
 // sheet across the block borders of every split.
-inline Scene free_body_scene(Integrator integrator) {
-  Scene scene = flat_sheet(13, 11);
-  scene.size1 = 1.2;
-  scene.size2 = 1.0;
-  scene.origin = {-0.6, 0.0, -0.5};
+// A soft, light sheet of m x n nodes and size1 x size2 m in the plane y = origin.y, under
+// gravity along −y: what the contact scenes below drop onto their solids.
+inline Scene soft_sheet(int m, int n, double size1, double size2, const Vec3& origin) {
+  Scene scene = flat_sheet(m, n);
+  scene.size1 = size1;
+  scene.size2 = size2;
+  scene.origin = origin;
   scene.material.mass = 0.25;
   scene.material.zeta = {20.0, 0.0, 20.0};
   scene.material.xi = {1e-3, 0.0, 1e-3};
   scene.material.phi = {0.0, 0.0, 0.0};
   scene.gravity = {0.0, -9.81, 0.0};
+  return scene;
+}
+
+inline Scene free_body_scene(Integrator integrator) {
+  Scene scene = soft_sheet(13, 11, 1.2, 1.0, {-0.6, 0.0, -0.5});
   scene.integrator = integrator;
   scene.steps = 160;
   scene.fixes.push_back(fix_nodes({{0, 0}, {12, 10}}));
@@ -201,15 +208,7 @@ inline Scene free_body_scene(Integrator integrator) {
 // tiles of nodes by their bounds, and its tiles follow the blocks, so a tile cleared wrongly
 // would show as a difference between splits.
 inline Scene many_solids_scene() {
-  Scene scene = flat_sheet(29, 23);
-  scene.size1 = 1.4;
-  scene.size2 = 1.1;
-  scene.origin = {-0.7, 0.1, -0.55};
-  scene.material.mass = 0.25;
-  scene.material.zeta = {20.0, 0.0, 20.0};
-  scene.material.xi = {1e-3, 0.0, 1e-3};
-  scene.material.phi = {0.0, 0.0, 0.0};
-  scene.gravity = {0.0, -9.81, 0.0};
+  Scene scene = soft_sheet(29, 23, 1.4, 1.1, {-0.7, 0.1, -0.55});
   scene.integrator = Integrator::verlet;
   scene.dt = 5e-4;
   scene.steps = 400;
