@@ -28,10 +28,13 @@ import numpy as np  # noqa: E402
 def node_mass(scene, m, n, last, gravity, summary):
     material = scene.get("material", {})
     size = scene["grid"]["size"]
+    # The energy form lumps mu0 h1 h2 on every node, the flux form M / (m n) (docs/model.md).
+    flux = scene.get("model", {}).get("discretisation", "energy") == "flux"
+    nodes = m * n if flux else (m - 1) * (n - 1)
     if "mass" in material:
-        return material["mass"] / (m * n)
+        return material["mass"] / nodes
     if "density" in material:
-        return material["density"] * size[0] * size[1] / (m * n)
+        return material["density"] * size[0] * size[1] / nodes
     if summary is None:
         raise SystemExit("a preset's mass is not in the output file: give --summary")
     # The summary's −Σ m g·r at the last step, the last frame.
