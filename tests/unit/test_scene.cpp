@@ -1148,7 +1148,7 @@ std::vector<std::filesystem::path> shipped_scenes() {
 
 TEST(ShippedScenes, LoadWithoutWarnings) {
   const auto paths = shipped_scenes();
-  EXPECT_GE(paths.size(), 29u);  // S1-S6 and the 23 gallery scenes
+  EXPECT_GE(paths.size(), 30u);  // S1-S6 and the 24 gallery scenes
   for (const auto& path : paths) {
     SCOPED_TRACE(path.string());
     const Scene scene = load_scene(path.string());
