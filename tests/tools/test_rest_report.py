@@ -48,9 +48,10 @@ output_every = 100
 nodes = [[0, 0], [6, 0]]
 """
 
+MODULI = "zeta = 50.0\nxi = 1e-3\nphi = 1e-3"
 MATERIALS = {
-    "mass": 'mass = 0.3\nzeta = 50.0\nxi = 1e-3\nphi = 1e-3',
-    "density": 'density = 0.5\nzeta = 50.0\nxi = 1e-3\nphi = 1e-3',
+    "mass": "mass = 0.3\n" + MODULI,
+    "density": "density = 0.5\n" + MODULI,
     "preset": 'preset = "cotton-10m"',
 }
 
