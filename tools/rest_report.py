@@ -8,9 +8,12 @@ the kinetic energy from the stored velocities, its peak and its last value over 
 same from the frames' own motion (|r_f - r_f-1| / dt between frames), which a velocity that
 says more than the nodes moved cannot match; the largest node move over the last frame; and the
 total energy, kinetic + gravitational (-sum m g.r) + elastic (energy_density times the rest
-cell area), with the frames where it rose. Loads, moving solids and free bodies do work this
-total does not count. The node mass is the scene's material.mass (or density times area) over
-the nodes; a preset's is read back from the run summary's gravitational energy (--summary).
+dual area), with the frames where it rose. Loads, moving solids and free bodies do work this
+total does not count. The node masses are the discretisation's (docs/model.md, "Energy
+quadrature"): mu0 h1 h2 times the node's share of the dual area (1 inside, 1/2 on a border,
+1/4 at a corner) in the default energy form, mu0 h1 h2 at every node in energy-nodal, M / (m n)
+in flux; mu0 from the scene's material.mass (or density), or for a preset read back from the
+run summary's gravitational energy (--summary).
 --table prints about 25 frames.
 """
 
@@ -25,20 +28,33 @@ import h5py  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def node_mass(scene, m, n, last, gravity, summary):
+def shares(scene, m, n):
+    """Each node's share of the dual area, and the cell count the masses divide M by."""
+    discretisation = scene.get("model", {}).get("discretisation", "energy")
+    if discretisation == "flux":
+        return np.ones((m, n)), m * n
+    if discretisation == "energy-nodal":
+        return np.ones((m, n)), (m - 1) * (n - 1)
+    wk = np.ones(m)
+    wk[[0, -1]] = 0.5
+    wl = np.ones(n)
+    wl[[0, -1]] = 0.5
+    return np.outer(wk, wl), (m - 1) * (n - 1)
+
+
+def node_masses(scene, m, n, last, gravity, summary):
     material = scene.get("material", {})
     size = scene["grid"]["size"]
-    # The energy form lumps mu0 h1 h2 on every node, the flux form M / (m n) (docs/model.md).
-    flux = scene.get("model", {}).get("discretisation", "energy") == "flux"
-    nodes = m * n if flux else (m - 1) * (n - 1)
+    share, cells = shares(scene, m, n)
     if "mass" in material:
-        return material["mass"] / nodes
+        return material["mass"] / cells * share
     if "density" in material:
-        return material["density"] * size[0] * size[1] / nodes
+        return material["density"] * size[0] * size[1] / cells * share
     if summary is None:
         raise SystemExit("a preset's mass is not in the output file: give --summary")
     # The summary's −Σ m g·r at the last step, the last frame.
-    return json.load(open(summary))["gravitational_energy"] / -(last.reshape(-1, 3) @ gravity).sum()
+    weighted = (share[..., None] * last).reshape(-1, 3) @ gravity
+    return json.load(open(summary))["gravitational_energy"] / -weighted.sum() * share
 
 
 def main():
@@ -57,17 +73,19 @@ def main():
         scene = tomllib.loads(f.attrs["scene"])
     frames, m, n, _ = r.shape
     g = np.array(scene.get("environment", {}).get("gravity", [0.0, -9.8, 0.0]))
-    mu = node_mass(scene, m, n, r[-1], g, args.summary)
+    mass = node_masses(scene, m, n, r[-1], g, args.summary)
     size = scene["grid"]["size"]
     cell = size[0] / (m - 1) * size[1] / (n - 1)
-    kinetic = 0.5 * mu * (v ** 2).sum(axis=(1, 2, 3))
-    total = kinetic - mu * (r.reshape(frames, -1, 3) @ g).sum(1) + density.sum(axis=(1, 2)) * cell
+    # energy_density stands for each node's dual area (docs/output.md).
+    dual = cell * shares(scene, m, n)[0]
+    kinetic = 0.5 * (mass * (v ** 2).sum(axis=-1)).sum(axis=(1, 2))
+    total = (kinetic - (mass * (r @ g)).sum(axis=(1, 2)) + (density * dual).sum(axis=(1, 2)))
     move = np.zeros(frames)
     kinetic_moved = np.zeros(frames)
     for i in range(1, frames):
         d = np.linalg.norm(r[i] - r[i - 1], axis=-1)
         move[i] = d.max()
-        kinetic_moved[i] = 0.5 * mu * ((d / (t[i] - t[i - 1])) ** 2).sum()
+        kinetic_moved[i] = 0.5 * (mass * (d / (t[i] - t[i - 1])) ** 2).sum()
     rise = np.diff(total)
     risen = rise > 1e-12 * np.abs(total).max()
     peak = kinetic.max()

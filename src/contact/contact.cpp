@@ -232,7 +232,7 @@ struct Contact::CellPush {
 };
 
 Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo,
-                 double node_mass, const Vec3& gravity, double spacing)
+                 const NodeMass& node_mass, const Vec3& gravity, double spacing)
     : block_(&block),
       halo_(&halo),
       node_mass_(node_mass),
@@ -354,13 +354,14 @@ void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const
                      const Vec3& v_before, const Vec3& r_after,
                      std::vector<Exchange>& out) const {
   if (solids_[solid].spec.motion != SolidMotion::free) return;
-  const Vec3 j = node_mass_ * (velocity_(k, l) - v_before);
+  const double mass = node_mass_(k, l);
+  const Vec3 j = mass * (velocity_(k, l) - v_before);
   const Block& b = *block_;
   const std::int64_t node = static_cast<std::int64_t>(l) * b.m + k;
   const std::int64_t nodes = static_cast<std::int64_t>(b.m) * b.n;
   const std::int64_t key =
       ((static_cast<std::int64_t>(solid) * nodes + node) * kMaxPasses + pass) * 2 + phase;
-  out.push_back({key, j, cross(r_after, j), node_mass_ * cross(r_after - r_before, v_before),
+  out.push_back({key, j, cross(r_after, j), mass * cross(r_after - r_before, v_before),
                  v_before});
 }
 
@@ -981,7 +982,10 @@ void Contact::apply_impulses(std::vector<Exchange>& exchanges) {
       }
       impulse += node_impulse;
       approach += dot(node_impulse, v0);
-      node_energy += dot(node_impulse, node_impulse) / (2.0 * node_mass_);
+      const std::int64_t node = node_key % nodes;
+      const double node_mass =
+          node_mass_(static_cast<int>(node % block_->m), static_cast<int>(node / block_->m));
+      node_energy += dot(node_impulse, node_impulse) / (2.0 * node_mass);
     }
     const double mass = s.spec.body.mass;
     const Vec3 moments = mass * s.inertia_per_mass;
@@ -1006,7 +1010,7 @@ void Contact::apply_impulses(std::vector<Exchange>& exchanges) {
     if (scale[solid] == 1.0) continue;
     const std::int64_t node = (e.key / (kMaxPasses * 2)) % nodes;
     const int k = static_cast<int>(node % b.m), l = static_cast<int>(node / b.m);
-    velocity_(k, l) -= ((1.0 - scale[solid]) / node_mass_) * e.impulse;
+    velocity_(k, l) -= ((1.0 - scale[solid]) / node_mass_(k, l)) * e.impulse;
   }
 }
 

@@ -101,20 +101,164 @@ energy::InteriorCoefficients interior_coefficients(const Sym2& Phi, const Sym2& 
   return c;
 }
 
+// The trapezoidal quadrature's interior constants (docs/equations.md, "Energy quadrature"):
+// the nodal ones but for the shear, whose tangents are the cell's, t_α = 2h_α a_α: ε₁₂ =
+// (t₁ · t₂)/(8h₁h₂) − ½A₁₂, so its e and ν (the coefficient of t₂ in ∂E/∂t₁) are a quarter of
+// the nodal ones.
+energy::InteriorCoefficients trapezoidal_coefficients(const Sym2& Phi, const Sym2& Psi,
+                                                      const Sym2& Theta, const Sym2& A,
+                                                      double h1, double h2) {
+  energy::InteriorCoefficients c = interior_coefficients(Phi, Psi, Theta, A, h1, h2);
+  c.e[1] *= 0.25;
+  c.nu_eps[1] *= 0.25;
+  c.nu_beta[1] *= 0.25;
+  return c;
+}
+
 }  // namespace
 
-CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest)
+CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest,
+                               Quadrature quadrature)
     : block_(&block),
       h1_(h1),
       h2_(h2),
       rest_(rest),
-      interior_{interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1, h2)},
+      quadrature_(quadrature),
+      interior_{quadrature == Quadrature::trapezoidal
+                    ? trapezoidal_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1,
+                                               h2)
+                    : interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1,
+                                            h2)},
       terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)} {}
 
-// E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (MODEL.md §2.5): the sum
-// over α, β counts the (1, 2) terms twice. Strains as §2.1 computes them.
 double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGradient* gradient,
-                                   Vec3* normal) const {
+                                   Vec3* normal, Parts* parts) const {
+  if (quadrature_ == Quadrature::trapezoidal)
+    return trapezoidal_energy(R, k, l, gradient, normal, parts);
+  return nodal_energy(R, k, l, gradient, normal);
+}
+
+// E_p of the trapezoidal quadrature (docs/equations.md, "Energy quadrature"): with w_k = ½ on
+// B1, B3 and 1 elsewhere, w_l likewise, and a = h₁h₂,
+//   the edge (k+½, l), weight w_l a:   Φ¹¹ ε₁₁²,   ε₁₁ = ½ (|D⁺₁ r|² − A₁₁) on the edge;
+//   the edge (k, l+½), weight w_k a:   Φ²² ε₂₂²;
+//   the cell (k+½, l+½), weight a:     2 (Φ¹² ε₁₂² + Ψ¹² κ₁₂² + Θ¹² ε₁₂ κ₁₂), from the cell's
+//                                      tangents, its normal and X₊₊;
+//   the node, where it has both α-neighbours, weight w_β a (β ≠ α):  Ψ^{αα} κ_αα² +
+//                                      Θ^{αα} ε̄_αα κ_αα, κ_αα = −n · D_αα r, ε̄_αα the mean of
+//                                      the strains of the node's two α-edges.
+double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
+                                          StencilGradient* gradient, Vec3* normal, Parts* parts,
+                                          bool node_terms) const {
+  const Neighbours p = geometry::neighbours(*block_, k, l);
+  const double h1 = h1_, h2 = h2_, area = h1 * h2;
+  const double wk = p.left && p.right ? 1.0 : 0.5, wl = p.down && p.up ? 1.0 : 0.5;
+  const bool bend11 = node_terms && p.left && p.right, bend22 = node_terms && p.down && p.up;
+  const bool cell = p.right && p.up;
+  const Sym2 &Phi = rest_.Phi, &Psi = rest_.Psi, &Theta = rest_.Theta, &A = rest_.metric;
+  const Vec3 r = R(k, l);
+  if (gradient != nullptr) gradient->fill(Vec3{});
+  StencilGradient* G = gradient;
+  auto add = [&](int dk, int dl, const Vec3& v) { (*G)[slot(dk, dl)] += v; };
+  Parts part;
+
+  // The edge strains around p: the forward edges' terms are E_p's own, the backward ones only
+  // enter the bending terms' ε̄.
+  const Vec3 right = p.right ? R(k + 1, l) - r : Vec3{};
+  const Vec3 left = p.left ? R(k - 1, l) - r : Vec3{};
+  const Vec3 up = p.up ? R(k, l + 1) - r : Vec3{}, down = p.down ? R(k, l - 1) - r : Vec3{};
+  auto strain = [](const Vec3& d, double h, double A_i) {
+    return 0.5 * (dot(d, d) / (h * h) - A_i);
+  };
+  const double eps11_f = strain(right, h1, A[0]), eps11_b = strain(left, h1, A[0]);
+  const double eps22_f = strain(up, h2, A[2]), eps22_b = strain(down, h2, A[2]);
+  // ∂E_p/∂ε of each of the four edge strains, built up term by term.
+  double N11_f = 0.0, N11_b = 0.0, N22_f = 0.0, N22_b = 0.0;
+  if (p.right) {
+    part.edge1 = wl * area * Phi[0] * eps11_f * eps11_f;
+    N11_f += 2.0 * wl * area * Phi[0] * eps11_f;
+  }
+  if (p.up) {
+    part.edge2 = wk * area * Phi[2] * eps22_f * eps22_f;
+    N22_f += 2.0 * wk * area * Phi[2] * eps22_f;
+  }
+
+  const bool needs_normal = (bend11 || bend22) || normal != nullptr;
+  CornerNormals corners;
+  if (needs_normal) corners = corner_normals(R, k, l, p);
+  if (normal != nullptr) *normal = corners.n;
+  Vec3 G_n;  // ∂E_p/∂n
+  auto bending = [&](bool exists, const Vec3& d, double h, double w, int i, double eps_f,
+                     double eps_b, double& N_f, double& N_b, int dk, int dl) {
+    if (!exists) return;
+    const Vec3 n = corners.n;
+    const double kappa = -dot(n, d) / (h * h), eps = 0.5 * (eps_f + eps_b);
+    part.node += w * area * (Psi[i] * kappa * kappa + Theta[i] * eps * kappa);
+    if (G == nullptr) return;
+    const double M = w * area * (2.0 * Psi[i] * kappa + Theta[i] * eps);  // ∂E_p/∂κ
+    N_f += 0.5 * w * area * Theta[i] * kappa;
+    N_b += 0.5 * w * area * Theta[i] * kappa;
+    // κ = −n · d/h²: ∂/∂d = −(M/h²) n, ∂/∂n = −(M/h²) d; d = r(p + e) + r(p − e) − 2 r.
+    const Vec3 G_d = (-M / (h * h)) * n;
+    add(dk, dl, G_d);
+    add(-dk, -dl, G_d);
+    add(0, 0, -2.0 * G_d);
+    G_n += (-M / (h * h)) * d;
+  };
+  bending(bend11, right + left, h1, wl, 0, eps11_f, eps11_b, N11_f, N11_b, 1, 0);
+  bending(bend22, up + down, h2, wk, 2, eps22_f, eps22_b, N22_f, N22_b, 0, 1);
+
+  if (cell) {
+    // The cell's tangents at its centre, times 2h_α, its normal and X₊₊ before its division.
+    const Vec3 diagonal = R(k + 1, l + 1) - r;
+    const Vec3 t1 = right + (diagonal - up), t2 = up + (diagonal - right);
+    const Vec3 X = (diagonal - right) - up;
+    const double eps12 = 0.5 * (dot(t1, t2) / (4.0 * area) - A[1]);
+    const Vec3 c = cross(t1, t2);
+    const double c_length = norm(c);
+    const Vec3 n = c / c_length;
+    const double kappa12 = -dot(n, X) / area;
+    part.cell = 2.0 * area *
+                (Phi[1] * eps12 * eps12 + Psi[1] * kappa12 * kappa12 + Theta[1] * eps12 * kappa12);
+    if (G != nullptr) {
+      const double N12 = 2.0 * area * (2.0 * Phi[1] * eps12 + Theta[1] * kappa12);
+      const double M12 = 2.0 * area * (2.0 * Psi[1] * kappa12 + Theta[1] * eps12);
+      // ε₁₂ = t₁ · t₂/(8a) − ½A₁₂; κ₁₂ = −n · X/a with n = c/|c|, c = t₁ × t₂.
+      Vec3 G_t1 = (N12 / (8.0 * area)) * t2, G_t2 = (N12 / (8.0 * area)) * t1;
+      const Vec3 G_X = (-M12 / area) * n, G_cn = (-M12 / area) * X;
+      const Vec3 G_c = (G_cn - dot(G_cn, n) * n) / c_length;
+      G_t1 += cross(t2, G_c);
+      G_t2 += cross(G_c, t1);
+      // t₁ = r(k+1, l) + r(k+1, l+1) − r − r(k, l+1), t₂ = r(k, l+1) + r(k+1, l+1) − r − r(k+1, l).
+      add(1, 0, G_t1 - G_t2 - G_X);
+      add(1, 1, G_t1 + G_t2 + G_X);
+      add(0, 1, G_t2 - G_t1 - G_X);
+      add(0, 0, G_X - G_t1 - G_t2);
+    }
+  }
+
+  if (G != nullptr) {
+    // ε = ½ (|d|²/h² − A): ∂/∂d = (N/h²) d, d = r(p ± e) − r.
+    auto edge = [&](double N, const Vec3& d, double h, int dk, int dl) {
+      const Vec3 g = (N / (h * h)) * d;
+      add(dk, dl, g);
+      add(0, 0, -1.0 * g);
+    };
+    if (p.right) edge(N11_f, right, h1, 1, 0);
+    if (p.left) edge(N11_b, left, h1, -1, 0);
+    if (p.up) edge(N22_f, up, h2, 0, 1);
+    if (p.down) edge(N22_b, down, h2, 0, -1);
+    if (bend11 || bend22) add_normal_gradient(corners, G_n, *G);
+  }
+  if (parts != nullptr) *parts = part;
+  return ((part.node + part.edge1) + part.edge2) + part.cell;
+}
+
+// E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (docs/equations.md,
+// "Nodal quadrature"): the sum over α, β counts the (1, 2) terms twice. Strains as the flux
+// form computes them at its nodes.
+double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilGradient* gradient,
+                                    Vec3* normal) const {
   using namespace geometry;
   const Neighbours p = neighbours(*block_, k, l);
   const Terms has = terms_of(p);
@@ -257,7 +401,7 @@ void CosseratEnergy::load_row(const Field<Vec3>& R, int l, int k_base, int k_end
   }
 }
 
-template <bool Bending, bool Coupling, bool Normal>
+template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
 void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const {
   const auto w = static_cast<std::size_t>(s.width);
   const double* below = s.positions.data() + 3 * ((l - 1) % 3) * w;
@@ -274,9 +418,13 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
         return Vec3{row[i], row[w + i], row[2 * w + i]};
       };
       Vec3 n;
-      const energy::InteriorGradient g = energy::interior_gradient<Bending, Coupling, Normal>(
-          co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c), at(below, c),
-          at(above, c + 1), n);
+      const energy::InteriorGradient g =
+          Trapezoidal ? energy::trapezoidal_gradient<Bending, Coupling, Normal>(
+                            co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c),
+                            at(below, c), at(above, c + 1), n)
+                      : energy::interior_gradient<Bending, Coupling, Normal>(
+                            co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c),
+                            at(below, c), at(above, c + 1), n);
       // Slot by slot: an array of pointers into g would give each lane's g an address, and
       // the loop would not vectorise.
       auto store = [&](int q, const Vec3& v) {
@@ -318,10 +466,10 @@ void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
   s.normal[2 * w + c] = n.z;
 }
 
-template <bool Bending, bool Coupling, bool Normal>
+template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
 void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double scale,
-                          const Vec3& offset, const RowConsumer& consume, int qa, int qb,
-                          RowScratch& s) const {
+                          const Vec3& offset, bool per_mass, const RowConsumer& consume, int qa,
+                          int qb, RowScratch& s) const {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   const int k_base = gk0 - 1;  // column 0; the force buffers take p's slots at k − 1
@@ -329,13 +477,23 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
   const auto w = static_cast<std::size_t>(s.width);
   auto force_row = [&](int q) { return s.force.data() + 3 * (q % 3) * w; };
   auto clear = [&](int q) { std::fill_n(force_row(q), 3 * w, 0.0); };
+  const bool dual_areas = per_mass && Trapezoidal;
   auto write_out = [&](int q) {
     double* f = force_row(q) + (b.k0 - k_base);
+    // Per unit mass, a border node's force is divided by its share ½ or ¼ of the dual area:
+    // doubled once on a border row and once in a border column, which is exact.
+    const double row_scale = dual_areas && (q == 0 || q == b.n - 1) ? 2.0 * scale : scale;
+    auto border_column = [&](int k) {
+      const auto i = static_cast<std::size_t>(k - b.k0);
+      for (int component = 0; component < 3; ++component) f[component * w + i] *= 2.0;
+    };
+    if (dual_areas && b.k0 == 0) border_column(0);
+    if (dual_areas && b.k1 == b.m) border_column(b.m - 1);
 #pragma omp simd
     for (int i = 0; i < b.owned_k(); ++i) {
-      f[i] = scale * f[i] + offset.x;
-      f[w + i] = scale * f[w + i] + offset.y;
-      f[2 * w + i] = scale * f[2 * w + i] + offset.z;
+      f[i] = row_scale * f[i] + offset.x;
+      f[w + i] = row_scale * f[w + i] + offset.y;
+      f[2 * w + i] = row_scale * f[2 * w + i] + offset.z;
     }
     consume(q, f, f + w, f + 2 * w);
   };
@@ -353,7 +511,7 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
       load_row(R, l - 1, k_base, k_end, s);
       load_row(R, l, k_base, k_end, s);
       load_row(R, l + 1, k_base, k_end, s);
-      if (ka < kb) interior_row<Bending, Coupling, Normal>(l, ka, kb, k_base, s);
+      if (ka < kb) interior_row<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
       if (gk0 == 0) border_node(R, 0, l, k_base, s);
       if (gk1 == b.m) border_node(R, b.m - 1, l, k_base, s);
     }
@@ -415,31 +573,70 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
 }
 
 void CosseratEnergy::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
-                                    Field<Vec3>* normals, double scale, const Vec3& offset) {
-  const Block& b = *block_;
-  all_bands(r, normals, scale, offset, [&](int l, const double* x, const double* y, const double* z) {
-    double* out = &force(b.k0, l).x;  // three packed doubles a node, as load_row reads them
-#pragma omp simd
-    for (int i = 0; i < b.owned_k(); ++i) {
-      out[3 * i] = x[i];
-      out[3 * i + 1] = y[i];
-      out[3 * i + 2] = z[i];
-    }
-  });
+                                    Field<Vec3>* normals) {
+  acceleration_or_force(r, force, normals, 1.0, Vec3{}, false);
 }
 
-void CosseratEnergy::internal_force_rows(const Field<Vec3>& r, double scale, const Vec3& offset,
-                                         const RowConsumer& consume) {
-  all_bands(r, nullptr, scale, offset, consume);
+void CosseratEnergy::acceleration(const Field<Vec3>& r, Field<Vec3>& a, Field<Vec3>* normals,
+                                  double inverse_mass, const Vec3& offset) {
+  acceleration_or_force(r, a, normals, inverse_mass, offset, true);
+}
+
+void CosseratEnergy::acceleration_or_force(const Field<Vec3>& r, Field<Vec3>& out,
+                                           Field<Vec3>* normals, double scale,
+                                           const Vec3& offset, bool per_mass) {
+  const Block& b = *block_;
+  all_bands(r, normals, scale, offset, per_mass,
+            [&](int l, const double* x, const double* y, const double* z) {
+              double* o = &out(b.k0, l).x;  // three packed doubles a node, as load_row reads
+#pragma omp simd
+              for (int i = 0; i < b.owned_k(); ++i) {
+                o[3 * i] = x[i];
+                o[3 * i + 1] = y[i];
+                o[3 * i + 2] = z[i];
+              }
+            });
+}
+
+void CosseratEnergy::internal_force_rows(const Field<Vec3>& r, double inverse_mass,
+                                         const Vec3& offset, const RowConsumer& consume) {
+  all_bands(r, nullptr, inverse_mass, offset, true, consume);
+}
+
+template <bool Trapezoidal>
+void CosseratEnergy::bands_of(const Field<Vec3>& r, Field<Vec3>* normals, double scale,
+                              const Vec3& offset, bool per_mass, const RowConsumer& consume,
+                              int qa, int qb, RowScratch& s) const {
+  const bool bending = terms_.bending, coupling = terms_.coupling;
+  if (normals != nullptr) {
+    if (!bending)
+      band<Trapezoidal, false, false, true>(r, normals, scale, offset, per_mass, consume, qa,
+                                            qb, s);
+    else if (coupling)
+      band<Trapezoidal, true, true, true>(r, normals, scale, offset, per_mass, consume, qa, qb,
+                                          s);
+    else
+      band<Trapezoidal, true, false, true>(r, normals, scale, offset, per_mass, consume, qa,
+                                           qb, s);
+  } else {
+    if (!bending)
+      band<Trapezoidal, false, false, false>(r, normals, scale, offset, per_mass, consume, qa,
+                                             qb, s);
+    else if (coupling)
+      band<Trapezoidal, true, true, false>(r, normals, scale, offset, per_mass, consume, qa,
+                                           qb, s);
+    else
+      band<Trapezoidal, true, false, false>(r, normals, scale, offset, per_mass, consume, qa,
+                                            qb, s);
+  }
 }
 
 void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, double scale,
-                               const Vec3& offset, const RowConsumer& consume) {
+                               const Vec3& offset, bool per_mass, const RowConsumer& consume) {
   const Block& b = *block_;
   const int gk0 = std::max(b.k0 - 1, 0), gk1 = std::min(b.k1 + 1, b.m);
   // Columns from gk0 − 1 to gk1, and the last interior block's lanes past it.
   const int columns = (gk1 - gk0 + 2) + 2 * kLanes;
-  const bool bending = terms_.bending, coupling = terms_.coupling;
   const int planned = omp_get_max_threads();
   if (static_cast<int>(scratch_.size()) < planned)
     scratch_.resize(static_cast<std::size_t>(planned));
@@ -460,21 +657,10 @@ void CosseratEnergy::all_bands(const Field<Vec3>& r, Field<Vec3>* normals, doubl
     };
     const int qa = band_start(t), qb = band_start(t + 1);
     if (qa < qb) {
-      if (normals != nullptr) {
-        if (!bending)
-          band<false, false, true>(r, normals, scale, offset, consume, qa, qb, s);
-        else if (coupling)
-          band<true, true, true>(r, normals, scale, offset, consume, qa, qb, s);
-        else
-          band<true, false, true>(r, normals, scale, offset, consume, qa, qb, s);
-      } else {
-        if (!bending)
-          band<false, false, false>(r, normals, scale, offset, consume, qa, qb, s);
-        else if (coupling)
-          band<true, true, false>(r, normals, scale, offset, consume, qa, qb, s);
-        else
-          band<true, false, false>(r, normals, scale, offset, consume, qa, qb, s);
-      }
+      if (quadrature_ == Quadrature::trapezoidal)
+        bands_of<true>(r, normals, scale, offset, per_mass, consume, qa, qb, s);
+      else
+        bands_of<false>(r, normals, scale, offset, per_mass, consume, qa, qb, s);
     }
     if (planned_split) balance_.record(t, omp_get_wtime() - start);
   }
@@ -498,9 +684,30 @@ double CosseratEnergy::block_energy(const Field<Vec3>& r) const {
 void CosseratEnergy::energy_density(const Field<Vec3>& r, Field<double>& density) const {
   const Block& b = *block_;
   const double area = h1_ * h2_;
+  if (quadrature_ == Quadrature::nodal) {
+#pragma omp parallel for schedule(static)
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k) density(k, l) = node_energy(r, k, l, nullptr) / area;
+    return;
+  }
+  const NodeMass share = node_mass(1.0);
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) density(k, l) = node_energy(r, k, l, nullptr) / area;
+    for (int k = b.k0; k < b.k1; ++k) {
+      // The node's own terms, half of each of its edges, a quarter of each of its cells; the
+      // edges and cells behind it are the forward ones of the nodes behind.
+      auto parts = [&](int dk, int dl) {
+        Parts p;
+        if (k + dk >= 0 && l + dl >= 0)
+          trapezoidal_energy(r, k + dk, l + dl, nullptr, nullptr, &p, dk == 0 && dl == 0);
+        return p;
+      };
+      const Parts here = parts(0, 0), left = parts(-1, 0), down = parts(0, -1),
+                  down_left = parts(-1, -1);
+      const double e = here.node + 0.5 * ((here.edge1 + left.edge1) + (here.edge2 + down.edge2)) +
+                       0.25 * (((here.cell + left.cell) + down.cell) + down_left.cell);
+      density(k, l) = e / (share.weight(k, l) * area);
+    }
 }
 
 }  // namespace cosserat

@@ -120,4 +120,93 @@ template <bool Bending, bool Coupling, bool Normal>
   return {g_centre, g_right, g_left, g_up, g_down, g_up_right};
 }
 
+// The same for the trapezoidal quadrature (docs/equations.md, "Energy quadrature"): an
+// interior node's E_p is its bending terms, the stretch of its two forward edges and the cell
+// (k+½, l+½), all of weight 1; it reads the same six nodes. The coefficients are
+// trapezoidal_coefficients' (cosserat_energy.cpp), and trapezoidal_energy is the general form.
+template <bool Bending, bool Coupling, bool Normal>
+[[gnu::always_inline]] inline InteriorGradient trapezoidal_gradient(
+    const InteriorCoefficients& c, const Vec3& r, const Vec3& r_right, const Vec3& r_left,
+    const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal) {
+  Vec3 g_right, g_left, g_up, g_down, g_up_right;
+  const Vec3 right = r_right - r, up = r_up - r, diagonal = r_up_right - r;
+  const double eps11 = c.e[0] * dot(right, right) - c.half_A[0];
+  const double eps22 = c.e[2] * dot(up, up) - c.half_A[2];
+  // The cell's tangents at its centre, times 2h_α: ε₁₂ = e₁₂ t₁ · t₂ − ½A₁₂.
+  const Vec3 t1 = right + (diagonal - up), t2 = up + (diagonal - right);
+  const double eps12 = c.e[1] * dot(t1, t2) - c.half_A[1];
+  // The coefficients of the forward edges in ∂E/∂D_α and of t₂, t₁ in ∂E/∂t₁, ∂E/∂t₂.
+  double nu11 = c.nu_eps[0] * eps11, nu12 = c.nu_eps[1] * eps12, nu22 = c.nu_eps[2] * eps22;
+
+  if (Bending || Normal) {
+    const Vec3 left = r_left - r, down = r_down - r;
+    const Corner q0 = corner(right, up), q1 = corner(up, left), q2 = corner(left, down),
+                 q3 = corner(down, right);
+    const Vec3 s = ((q0.unit + q1.unit) + q2.unit) + q3.unit;
+    const double s_length = std::sqrt(dot(s, s));
+    const Vec3 n = s * (1.0 / s_length);
+    normal = n;
+
+    if (Bending) {
+      const Vec3 d11 = right + left, d22 = up + down;
+      const double beta11 = dot(n, d11), beta22 = dot(n, d22);
+      double mu11 = c.mu_beta[0] * beta11, mu22 = c.mu_beta[2] * beta22;
+      // The backward edges' coefficients, for the coupling's ε̄ alone.
+      double nu11_b = 0.0, nu22_b = 0.0;
+      if (Coupling) {
+        const double eps11_b = c.e[0] * dot(left, left) - c.half_A[0];
+        const double eps22_b = c.e[2] * dot(down, down) - c.half_A[2];
+        mu11 += c.mu_eps[0] * (0.5 * (eps11 + eps11_b));
+        mu22 += c.mu_eps[2] * (0.5 * (eps22 + eps22_b));
+        nu11_b = 0.5 * c.nu_beta[0] * beta11;
+        nu22_b = 0.5 * c.nu_beta[2] * beta22;
+        nu11 += nu11_b;
+        nu22 += nu22_b;
+      }
+      const Vec3 G_X11 = mu11 * n, G_X22 = mu22 * n;
+      g_right = G_X11;
+      g_left = G_X11 + nu11_b * left;
+      g_up = G_X22;
+      g_down = G_X22 + nu22_b * down;
+      const Vec3 G_n = mu11 * d11 + mu22 * d22;
+      const Vec3 G_s = (G_n - dot(G_n, n) * n) * (1.0 / s_length);
+      const CornerGradient g0 = corner_gradient(q0, right, up, G_s),
+                           g1 = corner_gradient(q1, up, left, G_s),
+                           g2 = corner_gradient(q2, left, down, G_s),
+                           g3 = corner_gradient(q3, down, right, G_s);
+      g_right += g0.e;
+      g_up += g0.f;
+      g_up += g1.e;
+      g_left += g1.f;
+      g_left += g2.e;
+      g_down += g2.f;
+      g_down += g3.e;
+      g_right += g3.f;
+
+      // The cell's twist: κ₁₂ = −n_c · X/(h₁h₂), n_c = t₁ × t₂ normalised.
+      const Vec3 X = (diagonal - right) - up;
+      const Corner cell = corner(t1, t2);
+      const double beta12 = dot(cell.unit, X);
+      double mu12 = c.mu_beta[1] * beta12;
+      if (Coupling) {
+        nu12 += c.nu_beta[1] * beta12;
+        mu12 += c.mu_eps[1] * eps12;
+      }
+      const Vec3 G_X = mu12 * cell.unit;
+      const CornerGradient gc = corner_gradient(cell, t1, t2, mu12 * X);
+      // t₁ = r(k+1, l) + r(k+1, l+1) − r − r(k, l+1), t₂ = r(k, l+1) + r(k+1, l+1) − r −
+      // r(k+1, l), X = r(k+1, l+1) − r(k+1, l) − r(k, l+1) + r.
+      g_right += (gc.e - gc.f) - G_X;
+      g_up += (gc.f - gc.e) - G_X;
+      g_up_right = (gc.e + gc.f) + G_X;
+    }
+  }
+
+  g_right += nu11 * right + nu12 * (t2 - t1);
+  g_up += nu22 * up + nu12 * (t1 - t2);
+  g_up_right += nu12 * (t1 + t2);
+  const Vec3 g_centre = -((((g_right + g_left) + g_up) + g_down) + g_up_right);
+  return {g_centre, g_right, g_left, g_up, g_down, g_up_right};
+}
+
 }  // namespace cosserat::energy

@@ -248,20 +248,22 @@ void read_model(const Table& model, Scene& scene) {
   if (const auto discretisation = model.find("discretisation")) {
     const std::string name = discretisation->string();
     bool known = false;
-    for (const Discretisation d : {Discretisation::flux, Discretisation::energy})
+    for (const Discretisation d :
+         {Discretisation::flux, Discretisation::energy, Discretisation::energy_nodal})
       if (name == discretisation_name(d)) {
         scene.discretisation = d;
         known = true;
       }
     if (!known)
-      discretisation->fail(
-          fmt::format("unknown discretisation \"{}\"; allowed: flux, energy", name));
-    // The energy form's border terms are MODEL.md §2.5's; the published rules are the flux
-    // form's alone.
-    if (scene.discretisation == Discretisation::energy && scene.borders == Borders::published)
-      discretisation->fail(
-          "\"energy\" has no published border rules; use borders = \"symmetric\" (the "
-          "default) or discretisation = \"flux\"");
+      discretisation->fail(fmt::format(
+          "unknown discretisation \"{}\"; allowed: energy, energy-nodal, flux", name));
+    // The energy forms' border terms are docs/equations.md §2.5's; the published rules are the
+    // flux form's alone.
+    if (is_energy_form(scene.discretisation) && scene.borders == Borders::published)
+      discretisation->fail(fmt::format(
+          "\"{}\" has no published border rules; use borders = \"symmetric\" (the "
+          "default) or discretisation = \"flux\"",
+          name));
   }
 }
 
@@ -686,11 +688,22 @@ Fix read_fix(const Table& block, const Scene& scene) {
 }
 
 Load read_load(const Table& block, const Scene& scene) {
-  block.allow({"nodes", "region", "force", "start", "end", "start_time", "end_time"});
+  block.allow(
+      {"nodes", "region", "force", "pressure", "start", "end", "start_time", "end_time"});
   Load load;
   load.nodes = read_node_set(block, scene);
-  load.force =
-      block.require("force", "an array of 3 numbers [x, y, z] in newtons per node").vector3();
+  const auto pressure = block.find("pressure");
+  if (pressure && block.find("force"))
+    pressure->fail("give either force (newtons per node) or pressure (newtons per m²), not both");
+  if (pressure) {
+    load.force = pressure->vector3();
+    load.per_area = true;
+  } else {
+    load.force = block
+                     .require("force", "an array of 3 numbers [x, y, z] in newtons per node, or "
+                                       "pressure in newtons per m² of rest area")
+                     .vector3();
+  }
   load.window = read_window(block, scene);
   return load;
 }

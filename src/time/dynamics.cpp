@@ -11,16 +11,20 @@ namespace cosserat {
 Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions)
     : block_(&block),
       discretisation_(scene.discretisation),
-      energy_(block, scene.h1(), scene.h2(), flat_rest_state(scene.material, scene.u, scene.v)),
+      energy_(block, scene.h1(), scene.h2(), flat_rest_state(scene.material, scene.u, scene.v),
+              scene.discretisation == Discretisation::energy_nodal ? Quadrature::nodal
+                                                                   : Quadrature::trapezoidal),
       h1h2_(scene.h1() * scene.h2()),
       // 2⁻⁴⁰ of a grid cell: far below the round-off of a double sum over the cells.
       area_quantum_(std::ldexp(h1h2_, -40)),
       mass_(scene.material.mass),
       rest_area_(total_area(rest_positions)),
-      // μ0 h1 h2 = (M/S0) h1 h2: the lumped constant nodal mass of the energy form.
-      node_mass_(scene.discretisation == Discretisation::energy
-                     ? scene.material.mass / rest_area_ * h1h2_
-                     : scene.material.mass / (static_cast<double>(scene.m) * scene.n)),
+      // μ0 h1 h2 = (M/S0) h1 h2 at a node inside, times its share of the dual area in the
+      // trapezoidal quadrature: the lumped constant masses of the energy forms.
+      node_mass_(is_energy_form(scene.discretisation)
+                     ? energy_.node_mass(scene.material.mass / rest_area_ * h1h2_)
+                     : NodeMass{scene.material.mass / (static_cast<double>(scene.m) * scene.n),
+                                scene.m, scene.n, false}),
       gravity_(scene.gravity),
       damping_(scene.damping),
       fluid_(scene.fluid) {
@@ -28,8 +32,11 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
     gusts_.emplace(*fluid_->gusts, fluid_->velocity);
   for (const Load& load : scene.loads)
     for (const NodeIndex& node : load.nodes.nodes)
-      if (block.owns(node.k, node.l))
-        loads_.push_back(PointLoad{node.k, node.l, load.force, load.window});
+      if (block.owns(node.k, node.l)) {
+        // A pressure acts on the node's dual area: h1 h2 times its share of it.
+        const double area = load.per_area ? h1h2_ * node_mass_.weight(node.k, node.l) : 1.0;
+        loads_.push_back(PointLoad{node.k, node.l, area * load.force, load.window});
+      }
   // In row order, for free_acceleration_rows to find a row's loads; stable, so that a node's
   // own loads keep the scene's order and their sum its bits.
   std::stable_sort(loads_.begin(), loads_.end(),
@@ -66,9 +73,9 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
 #pragma omp simd
       for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l) + g;
   } else {
-    // Newtons on the constant nodal mass μ0 h1 h2 (§2.5), with gravity, written by the kernel;
-    // loads, damping and fluid per unit area act on μ0.
-    energy_.internal_force(r, a, normals, 1.0 / node_mass_, g);
+    // Newtons on the constant lumped masses (docs/model.md, "Energy quadrature"), with gravity,
+    // written by the kernel; damping and fluid per unit area act on μ0.
+    energy_.acceleration(r, a, normals, 1.0 / node_mass_.interior, g);
     inverse_density = rest_inverse_density();
   }
   const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
@@ -92,10 +99,12 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
         a(k, l) += (fluid_coefficient * dot(n, fluid_velocity)) * n;
       }
   }
-  // Point loads are newtons on the node's lumped mass μ h1 h2 (MODEL.md §1).
+  // Point loads are newtons on the node's lumped mass: μ h1 h2 in the flux form
+  // (docs/equations.md §1), times the node's share of the dual area in the trapezoidal one.
   for (const PointLoad& load : loads_)
     if (load.window.contains(step, time_))
-      a(load.k, load.l) += (inverse_density / h1h2_) * load.force;
+      a(load.k, load.l) +=
+          (inverse_density / (h1h2_ * node_mass_.weight(load.k, load.l))) * load.force;
   return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
 }
 
@@ -104,14 +113,15 @@ void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
   assert(fuses_rows());
   const Block& b = *block_;
   const double load_scale = rest_inverse_density() / h1h2_;
-  energy_.internal_force_rows(r, 1.0 / node_mass_, gravity_,
+  energy_.internal_force_rows(r, 1.0 / node_mass_.interior, gravity_,
                               [&](int l, double* x, double* y, double* z) {
     auto load = std::lower_bound(loads_.begin(), loads_.end(), l,
                                  [](const PointLoad& a, int row) { return a.l < row; });
     for (; load != loads_.end() && load->l == l; ++load)
       if (load->window.contains(step, time_)) {
         const auto i = static_cast<std::size_t>(load->k - b.k0);
-        const Vec3 acceleration = load_scale * load->force;
+        const Vec3 acceleration =
+            (load_scale / node_mass_.weight(load->k, load->l)) * load->force;
         x[i] += acceleration.x;
         y[i] += acceleration.y;
         z[i] += acceleration.z;
@@ -126,7 +136,7 @@ double Dynamics::elastic_energy(const Field<Vec3>& r) {
 
 void Dynamics::internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a) {
   if (!flux_) {
-    energy_.internal_force(r, a, nullptr, 1.0 / node_mass_);
+    energy_.acceleration(r, a, nullptr, 1.0 / node_mass_.interior, Vec3{});
     return;
   }
   const Block& b = *block_;

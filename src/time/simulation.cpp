@@ -144,39 +144,43 @@ Diagnostics Simulation::diagnostics() {
   const Field<Vec3>& v = stepper_.velocities();
   // Per-row partials summed in row order: the same result for any thread count.
   const auto rows = static_cast<std::size_t>(b.owned_l());
-  std::vector<double> speed2(rows), max_speed2(rows);
-  std::vector<Vec3> position_sum(rows);
+  std::vector<double> energy2(rows), max_speed2(rows), mass_sum(rows);
+  std::vector<Vec3> moment_sum(rows);
+  const NodeMass& mass = dynamics_.node_mass();
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l) {
     const auto row = static_cast<std::size_t>(l - b.l0);
-    double s2 = 0.0, max2 = 0.0;
+    double e2 = 0.0, max2 = 0.0, m = 0.0;
     Vec3 sum;
     for (int k = b.k0; k < b.k1; ++k) {
-      const double w2 = dot(v(k, l), v(k, l));
-      s2 += w2;
+      const double w2 = dot(v(k, l), v(k, l)), node = mass(k, l);
+      e2 += node * w2;
       max2 = std::max(max2, w2);
-      sum += r(k, l);
+      sum += node * r(k, l);
+      m += node;
     }
-    speed2[row] = s2;
+    energy2[row] = e2;
     max_speed2[row] = max2;
-    position_sum[row] = sum;
+    moment_sum[row] = sum;
+    mass_sum[row] = m;
   }
-  double s2 = 0.0, max2 = 0.0;
+  double e2 = 0.0, max2 = 0.0, m = 0.0;
   Vec3 sum;
   for (std::size_t row = 0; row < rows; ++row) {
-    s2 += speed2[row];
+    e2 += energy2[row];
     max2 = std::max(max2, max_speed2[row]);
-    sum += position_sum[row];
+    sum += moment_sum[row];
+    m += mass_sum[row];
   }
-  const double nodes = static_cast<double>(b.m) * b.n;
   Diagnostics d;
   d.area_ratio = dynamics_.total_area(r) / dynamics_.rest_area();
-  d.kinetic_energy = 0.5 * dynamics_.node_mass() * global_sum(s2, b.comm);
+  d.kinetic_energy = 0.5 * global_sum(e2, b.comm);
   d.max_speed = std::sqrt(global_max(max2, b.comm));
-  const Vec3 position_total{global_sum(sum.x, b.comm), global_sum(sum.y, b.comm),
-                            global_sum(sum.z, b.comm)};
-  d.center_of_mass = position_total / nodes;
-  d.gravitational_energy = -dynamics_.node_mass() * dot(scene_->gravity, position_total);
+  // Σ m r: the centre of mass and the potential of gravity, −Σ m g · r.
+  const Vec3 moment_total{global_sum(sum.x, b.comm), global_sum(sum.y, b.comm),
+                          global_sum(sum.z, b.comm)};
+  d.center_of_mass = moment_total / global_sum(m, b.comm);
+  d.gravitational_energy = -dot(scene_->gravity, moment_total);
   return d;
 }
 

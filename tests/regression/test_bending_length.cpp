@@ -101,10 +101,10 @@ struct Cantilever {
 // A strip of the preset along x¹ (axis 0) or x² (axis 1), three nodes across, horizontal, its
 // first two rows held: a clamp, whose discrete bending hinge lies midway between the two rows
 // (the curvature of the second row's nodes, counted over a whole cell, turns the strip from
-// half a cell before them). Each node carries the mass of the cell around it, so the strip ends
-// half a cell past its last node. The overhang l = 2c runs from midway between the held rows to
-// that end, (cells + 1) h, and the chord to the end's point on the line through the last two
-// nodes. Damped at twice the rate of the lowest bending mode, ω₁ = 1.875² √(B/(μ₀ l⁴)) =
+// half a cell before them). Each node carries the mass of its dual area, the last node half a
+// cell's, so the strip ends at its last node (docs/model.md, "Energy quadrature"). The overhang
+// l = 2c runs from midway between the held rows to that end, (cells + ½) h, and the chord to
+// the last node. Damped at twice the rate of the lowest bending mode, ω₁ = 1.875² √(B/(μ₀ l⁴)) =
 // 0.879 √(g/c), with steps of 0.8 of the CFL estimate's membrane step or 0.5 of its bending
 // step, the smaller (Verlet's measured limits are 0.88-0.94 and 0.60 of them, docs/stability.md;
 // the membrane sets it but for the softest knits at 32 cells), for 15/ω₁: by then its kinetic
@@ -114,7 +114,7 @@ Cantilever hang(const std::string& name, int axis, int cells) {
   const Preset preset = *find_preset(name);
   const double c = preset_bending_length(preset, axis);
   const double overhang = 2.0 * c;
-  const double h = overhang / (cells + 1);
+  const double h = overhang / (cells + 0.5);
   const int along = cells + 2;
   const double density = preset.mass / preset.area;
 
@@ -152,7 +152,7 @@ Cantilever hang(const std::string& name, int axis, int cells) {
     return axis == 0 ? sim.positions()(i, 1) : sim.positions()(1, i);
   };
   const Vec3 edge = 0.5 * (node(0) + node(1));
-  const Vec3 end = node(along - 1) + 0.5 * (node(along - 1) - node(along - 2));
+  const Vec3 end = node(along - 1);
   const double out = axis == 0 ? end.x - edge.x : end.z - edge.z;
   const double angle = std::atan2(edge.y - end.y, out);
   return {elastica_bending_length(angle, overhang), peirce_bending_length(angle, overhang), angle};

@@ -106,15 +106,17 @@ RestRecord run_to_rest(const Scene& scene, double seconds) {
   return out;
 }
 
-void expect_at_rest(const RestRecord& r, const char* what, bool energy_falls) {
+// `largest_rise`: the largest rise of the total energy from one frame to the next allowed, over
+// the peak kinetic energy; negative: not checked.
+void expect_at_rest(const RestRecord& r, const char* what, double largest_rise) {
   std::printf("[rest] %s: kinetic energy %.3g of its peak %.3g J, largest energy rise %.3g J "
               "(scale %.3g J), last frame's largest move %.3g m, speed gap %.3g m/s\n",
               what, r.final_kinetic / r.peak_kinetic, r.peak_kinetic, r.largest_rise,
               r.energy_scale, r.last_frame_move, r.largest_speed_gap);
   EXPECT_LT(r.final_kinetic, 1e-9 * r.peak_kinetic) << what;
   EXPECT_LT(r.last_frame_move, 1e-6) << what;
-  if (energy_falls) {
-    EXPECT_LE(r.largest_rise, 1e-6 * r.peak_kinetic) << what;
+  if (largest_rise >= 0.0) {
+    EXPECT_LE(r.largest_rise, largest_rise * r.peak_kinetic) << what;
   }
   // Backward difference (r − r⁻)/Δt against the last step's move.
   EXPECT_LT(r.largest_speed_gap, 1e-5) << what;
@@ -126,26 +128,29 @@ TEST(ContactRest, ASheetDroppedOnAPlaneComesToRest) {
   floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
   scene.solids.push_back(floor);
   const RestRecord r = run_to_rest(scene, 3.0);
-  expect_at_rest(r, "plane", true);
+  expect_at_rest(r, "plane", 1e-6);
   EXPECT_GT(r.lowest_height, 0.0);
 }
 
 // A table under the middle of the sheet, its top 5 cm below it: the sheet's edges hang over
 // the rim and the sheet must stay on the table.
 void expect_a_drape_over_a_table_at_rest(const SolidSpec& table, const char* what,
-                                         bool energy_falls) {
+                                         double largest_rise) {
   Scene scene = resolved_sheet(0.05);
   scene.solids.push_back(table);
   const RestRecord r = run_to_rest(scene, 4.0);
-  expect_at_rest(r, what, energy_falls);
+  expect_at_rest(r, what, largest_rise);
   EXPECT_GT(r.center_of_mass.y, -0.2) << what << ": slid off the table";
 }
 
-// A 0.3 m square table: the edges hang over its four edges and corners.
+// A 0.3 m square table: the edges hang over its four edges and corners. With the trapezoidal
+// quadrature's lighter border nodes the total energy rises in 12 of 80 frames while the skirt
+// settles (t = 1.2–2.5 s), by up to 7.8e-7 J, 3.7e-5 of the peak kinetic energy (below 1e-6
+// of it with the nodal quadrature's equal masses); docs/contact.md, "Resting contact".
 TEST(ContactRest, ASheetDrapedOverABoxComesToRest) {
   SolidSpec table = solid(ShapeKind::box, {0.0, -0.5, 0.0}, 0.5);
   table.shape.half_extents = {0.15, 0.5, 0.15};
-  expect_a_drape_over_a_table_at_rest(table, "box", true);
+  expect_a_drape_over_a_table_at_rest(table, "box", 1e-4);
 }
 
 // A round table, its axis vertical: the sheet hangs in folds around the rim.
@@ -154,7 +159,7 @@ TEST(ContactRest, ASheetDrapedOverACylinderComesToRest) {
   table.shape.radius = 0.17;
   table.shape.half_length = 0.5;
   table.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
-  expect_a_drape_over_a_table_at_rest(table, "cylinder", false);
+  expect_a_drape_over_a_table_at_rest(table, "cylinder", -1.0);
 }
 
 // Static friction that holds (μ = 0.5, no floor): the drape stays on the sphere and rests.
@@ -166,7 +171,7 @@ TEST(ContactRest, ASheetDrapedOverASphereWithFrictionStaysOnItAndRests) {
   ball.shape.radius = 0.4;
   scene.solids.push_back(ball);
   const RestRecord r = run_to_rest(scene, 6.0);
-  expect_at_rest(r, "sphere", true);
+  expect_at_rest(r, "sphere", 1e-6);
   EXPECT_GT(r.center_of_mass.y, 0.3) << "slid off the sphere";
 }
 

@@ -238,7 +238,7 @@ TEST(Contact, AFreeBodyAndTheSheetExchangeMomentumExactly) {
   ball.thickness = 1e-3;
   scene.solids.push_back(ball);
   Simulation sim(scene, MPI_COMM_SELF);
-  const double m = sim.node_mass();
+  const NodeMass& mass_of = sim.node_mass();
   const auto totals = [&](Vec3& p, Vec3& l, double& kinetic) {
     const Block& b = sim.block();
     p = l = {};
@@ -247,6 +247,7 @@ TEST(Contact, AFreeBodyAndTheSheetExchangeMomentumExactly) {
     const Field<Vec3>& v = sim.velocities();
     for (int j = b.l0; j < b.l1; ++j)
       for (int k = b.k0; k < b.k1; ++k) {
+        const double m = mass_of(k, j);
         p += m * v(k, j);
         l += m * cross(r(k, j), v(k, j));
         kinetic += 0.5 * m * dot(v(k, j), v(k, j));

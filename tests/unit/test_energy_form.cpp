@@ -1,5 +1,6 @@
-// The energy form of MODEL.md §2.5: its force is the exact negative gradient of its energy, the
-// energy is that of the §2.1 strains, and a damped run never gains energy.
+// The energy forms (docs/equations.md, "Energy quadrature", in both quadratures): the force is
+// the exact negative gradient of the energy, the energy is that of the discrete strains, and a
+// damped run never gains energy.
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -21,11 +22,11 @@ struct Sheet {
   Field<Vec3> r;
   CosseratEnergy energy;
 
-  explicit Sheet(const Scene& s)
+  explicit Sheet(const Scene& s, Quadrature q = Quadrature::trapezoidal)
       : scene(s),
         block(Block::whole(s.m, s.n, MPI_COMM_SELF)),
         r(block),
-        energy(block, s.h1(), s.h2(), flat_rest_state(s.material, s.u, s.v)) {
+        energy(block, s.h1(), s.h2(), flat_rest_state(s.material, s.u, s.v), q) {
     for (int l = 0; l < s.n; ++l)
       for (int k = 0; k < s.m; ++k) r(k, l) = testing::deformed(s, k, l);
   }
@@ -39,6 +40,10 @@ void fill_with_ghosts(const Block& b, Field<Vec3>& r, Position position) {
     for (int k = std::max(b.k0 - b.ghost, 0); k < std::min(b.k1 + b.ghost, b.m); ++k)
       r(k, l) = position(k, l);
 }
+
+constexpr Quadrature kQuadratures[] = {Quadrature::trapezoidal, Quadrature::nodal};
+
+const char* name(Quadrature q) { return q == Quadrature::trapezoidal ? "trapezoidal" : "nodal"; }
 
 Scene coupled_sheet() {
   // Unequal spacings and a coupling φ, so every term of E is exercised.
@@ -65,16 +70,18 @@ TEST(EnergyForm, ForcesAreBitwiseTheSameOnEverySplitOfTheRows) {
   Block part = whole;
   part.l0 = 2;
   const int threads_before = omp_get_max_threads();
+  for (const Quadrature q : kQuadratures)
   for (const Block* block : {&whole, &part}) {
+    SCOPED_TRACE(name(q));
     const Block& b = *block;
     Field<Vec3> r(b);
     fill_with_ghosts(b, r, [&](int k, int l) { return testing::deformed(scene, k, l); });
     Field<Vec3> force_one(b), normals_one(b);
     omp_set_num_threads(1);
-    CosseratEnergy one(b, scene.h1(), scene.h2(), rest);
+    CosseratEnergy one(b, scene.h1(), scene.h2(), rest, q);
     one.internal_force(r, force_one, &normals_one);
     omp_set_num_threads(3);
-    CosseratEnergy three(b, scene.h1(), scene.h2(), rest);
+    CosseratEnergy three(b, scene.h1(), scene.h2(), rest, q);
     const long rows = b.owned_l();
     int splits = 0;
     for (long first = 1; first < rows - 1; ++first)
@@ -99,7 +106,9 @@ TEST(EnergyForm, ForcesAreBitwiseTheSameOnEverySplitOfTheRows) {
 
 // −∂E/∂r by central differences of E, against the kernel's force at every node and component.
 TEST(EnergyForm, ForceIsMinusTheGradientOfTheEnergy) {
-  Sheet sheet(coupled_sheet());
+  for (const Quadrature q : kQuadratures) {
+  SCOPED_TRACE(name(q));
+  Sheet sheet(coupled_sheet(), q);
   Field<Vec3> force(sheet.block);
   sheet.energy.internal_force(sheet.r, force);
   const double step = 1e-6;
@@ -119,6 +128,7 @@ TEST(EnergyForm, ForceIsMinusTheGradientOfTheEnergy) {
       }
   ASSERT_GT(largest, 1.0);  // the sheet is well away from rest
   EXPECT_LT(worst, 1e-6 * largest) << "largest force component " << largest;
+  }
 }
 
 // The row kernel (interior nodes eight lanes at a time, the border ring through node_energy)
@@ -137,7 +147,9 @@ TEST(EnergyForm, RowKernelAgreesWithTheNodeGradients) {
                         {10, 12, {0.3, 0.2, 0.4}, {0.0, 0.0, 0.0}},
                         {21, 7, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}},
                         {19, 17, {0.0, 0.0, 0.0}, {0.05, 0.0, 0.0}}};
+  for (const Quadrature q : kQuadratures)
   for (const Case& c : cases) {
+    SCOPED_TRACE(name(q));
     Scene scene = testing::flat_sheet(c.m, c.n);
     scene.size2 = 8.0;
     scene.material.xi = c.xi;
@@ -152,7 +164,7 @@ TEST(EnergyForm, RowKernelAgreesWithTheNodeGradients) {
       const Block& b = *block;
       Field<Vec3> r(b), force(b), normals(b);
       fill_with_ghosts(b, r, [&](int k, int l) { return testing::deformed(scene, k, l); });
-      CosseratEnergy energy(b, scene.h1(), scene.h2(), rest);
+      CosseratEnergy energy(b, scene.h1(), scene.h2(), rest, q);
       // A first call at rest positions: nothing of it may carry into the next.
       {
         Field<Vec3> rest_r(b);
@@ -194,7 +206,9 @@ TEST(EnergyForm, RowKernelAgreesWithTheNodeGradients) {
 
 // The Jacobian of the force is the negative Hessian of E: symmetric, to finite-difference noise.
 TEST(EnergyForm, JacobianIsSymmetric) {
-  Sheet sheet(coupled_sheet());
+  for (const Quadrature q : kQuadratures) {
+  SCOPED_TRACE(name(q));
+  Sheet sheet(coupled_sheet(), q);
   const int m = sheet.scene.m, n = sheet.scene.n, size = 3 * m * n;
   std::vector<double> J(static_cast<std::size_t>(size) * size);
   Field<Vec3> up(sheet.block), down(sheet.block);
@@ -221,12 +235,15 @@ TEST(EnergyForm, JacobianIsSymmetric) {
       worst = std::max(worst, std::abs(J[static_cast<std::size_t>(row) * size + column] -
                                         J[static_cast<std::size_t>(column) * size + row]));
   EXPECT_LT(worst, 1e-6 * largest) << "largest entry " << largest;
+  }
 }
 
 // MODEL.md §5 item 1 for the energy form: a rotated and translated rest sheet stores no energy
 // and feels no force.
 TEST(EnergyForm, RigidMotionHasNoEnergyAndNoForce) {
-  Sheet sheet(coupled_sheet());
+  for (const Quadrature q : kQuadratures) {
+  SCOPED_TRACE(name(q));
+  Sheet sheet(coupled_sheet(), q);
   const double c = std::cos(0.7), s = std::sin(0.7);
   for (int l = 0; l < sheet.scene.n; ++l)
     for (int k = 0; k < sheet.scene.m; ++k) {
@@ -246,6 +263,7 @@ TEST(EnergyForm, RigidMotionHasNoEnergyAndNoForce) {
   const double zeta = sheet.scene.material.zeta[0];
   EXPECT_LT(worst, 1e-12 * zeta * sheet.scene.h2());
   EXPECT_LT(std::abs(sheet.total()), 1e-20 * zeta * sheet.scene.size1 * sheet.scene.size2);
+  }
 }
 
 // E depends on the positions only through their differences and is unchanged by a rotation, so
@@ -256,7 +274,9 @@ TEST(EnergyForm, InternalForcesHaveNoNetForceAndNoNetTorque) {
   Scene scene = coupled_sheet();
   scene.m = 21;
   scene.n = 9;
-  Sheet sheet(scene);
+  for (const Quadrature q : kQuadratures) {
+  SCOPED_TRACE(name(q));
+  Sheet sheet(scene, q);
   Field<Vec3> force(sheet.block);
   sheet.energy.internal_force(sheet.r, force);
   Vec3 net, torque;
@@ -271,13 +291,14 @@ TEST(EnergyForm, InternalForcesHaveNoNetForceAndNoNetTorque) {
   ASSERT_GT(magnitude, 1.0);  // the sheet is well away from rest
   EXPECT_LT(norm(net), 1e-13 * magnitude);
   EXPECT_LT(norm(torque), 1e-13 * magnitude * lever);
+  }
 }
 
 // Kinetic + elastic + gravitational energy of a damped sheet falling from a held corner, after
 // every step: the largest rise from one step to the next, and what damping took in all.
-double largest_energy_rise(double dt, double* total_drop) {
+double largest_energy_rise(Discretisation d, double dt, double* total_drop) {
   Scene scene = testing::flat_sheet(10, 10);
-  scene.discretisation = Discretisation::energy;
+  scene.discretisation = d;
   scene.integrator = Integrator::velocity_verlet;
   scene.gravity = {0.0, -9.8, 0.0};
   scene.damping = 0.2;
@@ -306,12 +327,13 @@ double largest_energy_rise(double dt, double* total_drop) {
 // The integrator may let the total wobble by its O(Δt²) error; measured, the total falls at
 // every step at both steps here (largest rise 0), so the bound is round-off of the total.
 TEST(EnergyForm, DampedRunNeverGainsEnergy) {
-  for (const double dt : {2e-3, 1e-3}) {
-    double drop = 0.0;
-    const double rise = largest_energy_rise(dt, &drop);
-    EXPECT_GT(drop, 10.0) << "dt " << dt;  // the sheet falls: hundreds of joules damped
-    EXPECT_LE(rise, 1e-12 * drop) << "dt " << dt;
-  }
+  for (const Discretisation d : {Discretisation::energy, Discretisation::energy_nodal})
+    for (const double dt : {2e-3, 1e-3}) {
+      double drop = 0.0;
+      const double rise = largest_energy_rise(d, dt, &drop);
+      EXPECT_GT(drop, 10.0) << "dt " << dt;  // the sheet falls: hundreds of joules damped
+      EXPECT_LE(rise, 1e-12 * drop) << discretisation_name(d) << ", dt " << dt;
+    }
 }
 
 // The material constants in physical terms (docs/materials.md, "Units"), from the energy of
@@ -326,45 +348,54 @@ TEST(EnergyForm, MaterialConstants) {
   s.material.xi = {2e-6, 2e-6, 2e-6};
   s.material.phi = {0.0, 0.0, 0.0};
   const double h1 = s.h1(), h2 = s.h2();
-  Sheet sheet(s);
-  // Every node carries the energy of one cell, h₁h₂ (MODEL.md §2.5); the terms of a node that
-  // lacks the forward cell or a neighbour are left out, so each count is of the nodes that have
-  // the term.
-  const auto place = [&](auto&& position) {
-    for (int l = 0; l < s.n; ++l)
-      for (int k = 0; k < s.m; ++k) sheet.r(k, l) = position(k * h1, l * h2);
-  };
+  for (const Quadrature q : kQuadratures) {
+    SCOPED_TRACE(name(q));
+    Sheet sheet(s, q);
+    // The area each kind of term is summed over. Trapezoidal: the sheet's, L₁L₂, for every
+    // term but κ₁₁, which lives at the nodes with both k-neighbours, (m − 2)h₁ L₂. Nodal: every
+    // node carries one cell, h₁h₂, and the terms a node lacks a neighbour or its forward cell
+    // for are left out.
+    const bool trapezoidal = q == Quadrature::trapezoidal;
+    const double sheet_area = (s.m - 1) * h1 * (s.n - 1) * h2, cell = h1 * h2;
+    const double stretch_area = trapezoidal ? sheet_area : s.m * s.n * cell;
+    const double shear_area = trapezoidal ? sheet_area : (s.m - 1) * (s.n - 1) * cell;
+    const double bend_area = trapezoidal ? (s.m - 2) * h1 * (s.n - 1) * h2 : (s.m - 2) * s.n * cell;
+    const auto place = [&](auto&& position) {
+      for (int l = 0; l < s.n; ++l)
+        for (int k = 0; k < s.m; ++k) sheet.r(k, l) = position(k * h1, l * h2);
+    };
 
-  const double stretch = 1.001;  // ε₁₁ = ½(λ² − 1), exactly at every node
-  place([&](double x, double z) { return Vec3{stretch * x, 0.0, z}; });
-  const double epsilon = 0.5 * (stretch * stretch - 1.0);
-  EXPECT_NEAR(sheet.total() / (s.m * s.n * h1 * h2),
-              3.0 * s.material.zeta[0] * epsilon * epsilon, 1e-12);
+    const double stretch = 1.001;  // ε₁₁ = ½(λ² − 1), exactly on every edge
+    place([&](double x, double z) { return Vec3{stretch * x, 0.0, z}; });
+    const double epsilon = 0.5 * (stretch * stretch - 1.0);
+    EXPECT_NEAR(sheet.total() / stretch_area, 3.0 * s.material.zeta[0] * epsilon * epsilon,
+                1e-12);
 
-  const double gamma = 1e-3;  // a1 · a2 = γ, a_αα = 1 + γ²/4: ε₁₂ = γ/2, ε_αα = γ²/8
-  place([&](double x, double z) { return Vec3{x + 0.5 * gamma * z, 0.0, z + 0.5 * gamma * x}; });
-  const double shear = s.material.zeta[1] * gamma * gamma / 2.0;
-  const double stretched = 2.0 * 3.0 * s.material.zeta[0] * std::pow(gamma * gamma / 8.0, 2);
-  EXPECT_NEAR(sheet.total(),
-              (s.m - 1) * (s.n - 1) * h1 * h2 * shear + s.m * s.n * h1 * h2 * stretched,
-              1e-9 * sheet.total());
+    const double gamma = 1e-3;  // a1 · a2 = γ, a_αα = 1 + γ²/4: ε₁₂ = γ/2, ε_αα = γ²/8
+    place(
+        [&](double x, double z) { return Vec3{x + 0.5 * gamma * z, 0.0, z + 0.5 * gamma * x}; });
+    const double shear = s.material.zeta[1] * gamma * gamma / 2.0;
+    const double stretched = 2.0 * 3.0 * s.material.zeta[0] * std::pow(gamma * gamma / 8.0, 2);
+    EXPECT_NEAR(sheet.total(), shear_area * shear + stretch_area * stretched,
+                1e-9 * sheet.total());
 
-  // A cylinder of radius R about z, the nodes on the circle: D₁₁r is radial, of length
-  // κ = 2(1 − cos(h/R))R/h² (→ 1/R), and every tangent is a chord, shorter than h, which adds
-  // a uniform ε₁₁ = ½((2R sin(h/2R)/h)² − 1). κ₁₁ is left out on the k borders.
-  const double R = 1.0;
-  place([&](double x, double z) {
-    return Vec3{R * std::sin(x / R), R * (1.0 - std::cos(x / R)), z};
-  });
-  const double kappa = 2.0 * (1.0 - std::cos(h1 / R)) * R / (h1 * h1);
-  const double chord = 2.0 * R * std::sin(h1 / (2.0 * R)) / h1;
-  const double shortened = 0.5 * (chord * chord - 1.0);
-  const double bending = 3.0 * s.material.xi[0] * kappa * kappa;
-  EXPECT_NEAR(sheet.total(),
-              s.m * s.n * h1 * h2 * 3.0 * s.material.zeta[0] * shortened * shortened +
-                  (s.m - 2) * s.n * h1 * h2 * bending,
-              1e-9 * sheet.total());
-  EXPECT_NEAR(kappa, 1.0 / R, 1e-5);
+    // A cylinder of radius R about z, the nodes on the circle: D₁₁r is radial, of length
+    // κ = 2(1 − cos(h/R))R/h² (→ 1/R), and every k-edge is a chord, shorter than h, which adds
+    // a uniform ε₁₁ = ½((2R sin(h/2R)/h)² − 1).
+    const double R = 1.0;
+    place([&](double x, double z) {
+      return Vec3{R * std::sin(x / R), R * (1.0 - std::cos(x / R)), z};
+    });
+    const double kappa = 2.0 * (1.0 - std::cos(h1 / R)) * R / (h1 * h1);
+    const double chord = 2.0 * R * std::sin(h1 / (2.0 * R)) / h1;
+    const double shortened = 0.5 * (chord * chord - 1.0);
+    const double bending = 3.0 * s.material.xi[0] * kappa * kappa;
+    EXPECT_NEAR(sheet.total(),
+                stretch_area * 3.0 * s.material.zeta[0] * shortened * shortened +
+                    bend_area * bending,
+                1e-9 * sheet.total());
+    EXPECT_NEAR(kappa, 1.0 / R, 1e-5);
+  }
 }
 
 }  // namespace

@@ -67,10 +67,12 @@ TEST(FusedRows, AreTheFieldsAccelerationBitForBit) {
       // without loads, the loaded nodes gain force / node mass.
       Field<Vec3> unloaded(block);
       unloaded_dynamics.free_acceleration(r, step, unloaded, nullptr);
-      const double m = dynamics.node_mass();
+      const NodeMass& m = dynamics.node_mass();
       const Vec3 gained = by_rows(3, 4) - unloaded(3, 4);
-      EXPECT_NEAR(gained.y, (first.force.y + second.force.y) / m, 1e-9 * std::abs(gained.y));
-      EXPECT_NEAR(by_rows(20, 11).x - unloaded(20, 11).x, first.force.x / m, 1e-9 / m);
+      EXPECT_NEAR(gained.y, (first.force.y + second.force.y) / m(3, 4),
+                  1e-9 * std::abs(gained.y));
+      EXPECT_NEAR(by_rows(20, 11).x - unloaded(20, 11).x, first.force.x / m(20, 11),
+                  1e-9 / m(20, 11));
       EXPECT_EQ(same_bits(by_rows(30, 0), unloaded(30, 0)), step > 4);
     }
   }

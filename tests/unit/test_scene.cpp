@@ -956,16 +956,21 @@ TEST(Scene, DiscretisationDefaultsToTheEnergyForm) {
   EXPECT_EQ(parse(text).discretisation, Discretisation::flux);
   EXPECT_EQ(parse(SceneText{}, {"model.discretisation=\"flux\""}).discretisation,
             Discretisation::flux);
+  text.tail = "[model]\ndiscretisation = \"energy-nodal\"\n";
+  EXPECT_EQ(parse(text).discretisation, Discretisation::energy_nodal);
 }
 
 TEST(SceneError, UnknownDiscretisationAndEnergyWithPublishedBorders) {
   SceneText text;
   text.tail = "[model]\ndiscretisation = \"fem\"\n";
   EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.discretisation'"),
-                                    HasSubstr("allowed: flux, energy")));
-  text.tail = "[model]\ndiscretisation = \"energy\"\nborders = \"published\"\n";
-  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.discretisation'"),
-                                    HasSubstr("no published border rules")));
+                                    HasSubstr("allowed: energy, energy-nodal, flux")));
+  for (const char* name : {"energy", "energy-nodal"}) {
+    text.tail = std::string("[model]\ndiscretisation = \"") + name +
+                "\"\nborders = \"published\"\n";
+    EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.discretisation'"),
+                                      HasSubstr("no published border rules")));
+  }
 }
 
 // Issue 12: a header of 50 000 dotted parts crashed the TOML parser; it is refused first, with

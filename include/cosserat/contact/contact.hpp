@@ -11,6 +11,7 @@
 #include "cosserat/contact/geometry.hpp"
 #include "cosserat/contact/solid.hpp"
 #include "cosserat/grid/block.hpp"
+#include "cosserat/model/node_mass.hpp"
 #include "cosserat/grid/halo.hpp"
 
 namespace cosserat {
@@ -36,9 +37,9 @@ struct ContactStats {
 
 class Contact {
  public:
-  // `node_mass` is the lumped mass of every node (kg), `spacing` the smaller grid spacing.
-  Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo, double node_mass,
-          const Vec3& gravity, double spacing);
+  // `node_mass` gives the lumped mass of each node (kg), `spacing` the smaller grid spacing.
+  Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo& halo,
+          const NodeMass& node_mass, const Vec3& gravity, double spacing);
   ~Contact();
   Contact(const Contact&) = delete;
   Contact& operator=(const Contact&) = delete;
@@ -133,7 +134,7 @@ class Contact {
   std::vector<Solid> solids_;
   const Block* block_;
   Halo* halo_;
-  double node_mass_;
+  NodeMass node_mass_;
   Vec3 gravity_;
   double spacing_;
   double dt_ = 0.0;           // of the step being proposed

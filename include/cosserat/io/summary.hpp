@@ -35,7 +35,7 @@ struct RunSummary {
   std::optional<long> unstable_step;
   double area_ratio = 0.0;  // S / S0 at the end
   double max_speed = 0.0;
-  std::string discretisation;  // "flux" or "energy"
+  std::string discretisation;  // "energy", "energy-nodal" or "flux"
   double kinetic_energy = 0.0;
   double elastic_energy = 0.0;        // E of MODEL.md §2.5 (for the flux form too)
   double gravitational_energy = 0.0;  // −Σ m g·r

@@ -1,6 +1,7 @@
 #pragma once
-// The Cosserat surface in its energy form (MODEL.md §2.5): the stored energy of the strains of
-// §2.1, summed over the nodes, and the internal force as its exact negative gradient.
+// The Cosserat surface in its energy forms (docs/equations.md, "Energy quadrature"): the stored
+// energy of the discrete strains summed over the grid, and the internal force as its exact
+// negative gradient.
 
 #include <array>
 #include <functional>
@@ -9,6 +10,7 @@
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/threads.hpp"
 #include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/model/node_mass.hpp"
 #include "cosserat/grid/vec3.hpp"
 
 namespace cosserat {
@@ -43,41 +45,68 @@ struct Terms {
 
 }  // namespace energy
 
+// How the stored energy is summed (docs/equations.md, "Energy quadrature"). trapezoidal: each
+// strain where its difference is centred (stretch on its edge, shear and twist on the cell,
+// bending at the node), with the trapezoidal rule's weights and masses from the dual areas;
+// the default. nodal: every strain at its node from one-sided differences, every node weighted
+// alike (the form of MODEL.md §2.5 that was the default until 2026-12).
+enum class Quadrature { trapezoidal, nodal };
+
 class CosseratEnergy {
  public:
-  CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest);
+  CosseratEnergy(const Block& block, double h1, double h2, const RestState& rest,
+                 Quadrature quadrature = Quadrature::trapezoidal);
+
+  Quadrature quadrature() const { return quadrature_; }
+  // The lumped masses that go with the quadrature, for a node of all four neighbours carrying
+  // `interior` kg.
+  NodeMass node_mass(double interior) const {
+    return {interior, block_->m, block_->n, quadrature_ == Quadrature::trapezoidal};
+  }
 
   // −∂E/∂r at every owned node, in newtons. Each node's energy depends on the 3 × 3 box around
   // it, so the force at q gathers the gradients of the nine nodes around q, always in the same
   // order: any decomposition gives the same bits. Reads positions two nodes beyond the owned
   // range (ghosts must be current). With `normals`, also the unit normal n of every owned node.
-  // Writes scale · f + offset, so that the step's acceleration f/m + g takes no sweep of its
-  // own.
   void internal_force(const Field<Vec3>& positions, Field<Vec3>& force,
-                      Field<Vec3>* normals = nullptr, double scale = 1.0,
-                      const Vec3& offset = {});
+                      Field<Vec3>* normals = nullptr);
 
-  // A finished row l of scale · f + offset, as three component arrays over the owned columns
+  // The force as an acceleration: inverse_mass · f / w + offset, w = node_mass(…).weight(k, l),
+  // so that the step's f/m + g takes no sweep of its own (inverse_mass = 1/interior mass).
+  void acceleration(const Field<Vec3>& positions, Field<Vec3>& a, Field<Vec3>* normals,
+                    double inverse_mass, const Vec3& offset);
+
+  // A finished row l of acceleration's a, as three component arrays over the owned columns
   // (column b.k0 first), handed over while it is still in cache instead of written to a field;
   // the consumer may change them. Called from the thread that owns the row, once per owned row,
   // in ascending order within a thread.
   using RowConsumer = std::function<void(int l, double* x, double* y, double* z)>;
-  void internal_force_rows(const Field<Vec3>& positions, double scale, const Vec3& offset,
-                           const RowConsumer& consume);
+  void internal_force_rows(const Field<Vec3>& positions, double inverse_mass,
+                           const Vec3& offset, const RowConsumer& consume);
 
   // This block's share of E (J): the energies of the nodes it owns, summed row by row in order.
   // Reads the ghosts one node beyond the owned range.
   double block_energy(const Field<Vec3>& positions) const;
 
-  // E_p/(h₁h₂) at every owned node: the stored energy per unit rest area (J/m²) of §2.5.
+  // The stored energy per unit rest area (J/m²) at every owned node: in the trapezoidal
+  // quadrature the node's bending terms, half of each edge and a quarter of each cell around
+  // it, over its dual area; in the nodal one E_p/(h₁h₂). Either way Σ density · dual area = E.
   // Reads the ghosts one node beyond the owned range.
   void energy_density(const Field<Vec3>& positions, Field<double>& density) const;
 
-  // E_p of one node and, with `gradient`, ∂E_p/∂r at the nodes of its 3 × 3 box, indexed
-  // 3 (dl + 1) + (dk + 1) for the node (k + dk, l + dl). Public for the gradient tests.
+  // The terms of E_p by where they live (trapezoidal quadrature), each with its weight: the
+  // node's bending terms, the edges to (k+1, l) and (k, l+1), the cell (k+½, l+½).
+  struct Parts {
+    double node = 0.0, edge1 = 0.0, edge2 = 0.0, cell = 0.0;
+  };
+
+  // E_p of one node — in the trapezoidal quadrature the terms at the node, on its forward edges
+  // and on its forward cell, so that each term of E belongs to one node — and, with `gradient`,
+  // ∂E_p/∂r at the nodes of its 3 × 3 box, indexed 3 (dl + 1) + (dk + 1) for the node
+  // (k + dk, l + dl). Public for the gradient tests.
   using StencilGradient = std::array<Vec3, 9>;
   double node_energy(const Field<Vec3>& positions, int k, int l, StencilGradient* gradient,
-                     Vec3* normal = nullptr) const;
+                     Vec3* normal = nullptr, Parts* parts = nullptr) const;
 
   // The threads' bands of owned rows, which follow the threads' speeds. Public for the tests that
   // hold the forces to the same bits on every split.
@@ -94,18 +123,33 @@ class CosseratEnergy {
   };
 
   void load_row(const Field<Vec3>& positions, int l, int k_base, int k_end, RowScratch& s) const;
-  template <bool Bending, bool Coupling, bool Normal>
+  template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
   void interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const;
   void border_node(const Field<Vec3>& positions, int k, int l, int k_base, RowScratch& s) const;
-  template <bool Bending, bool Coupling, bool Normal>
+  template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
   void band(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
-            const Vec3& offset, const RowConsumer& consume, int qa, int qb, RowScratch& s) const;
+            const Vec3& offset, bool per_mass, const RowConsumer& consume, int qa, int qb,
+            RowScratch& s) const;
+  template <bool Trapezoidal>
+  void bands_of(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
+                const Vec3& offset, bool per_mass, const RowConsumer& consume, int qa, int qb,
+                RowScratch& s) const;
   void all_bands(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
-                 const Vec3& offset, const RowConsumer& consume);
+                 const Vec3& offset, bool per_mass, const RowConsumer& consume);
+  void acceleration_or_force(const Field<Vec3>& positions, Field<Vec3>& out,
+                             Field<Vec3>* normals, double scale, const Vec3& offset,
+                             bool per_mass);
+  double nodal_energy(const Field<Vec3>& positions, int k, int l, StencilGradient* gradient,
+                      Vec3* normal) const;
+  // Without `node_terms`, the edges and the cell alone (they read no normal of p).
+  double trapezoidal_energy(const Field<Vec3>& positions, int k, int l,
+                            StencilGradient* gradient, Vec3* normal, Parts* parts,
+                            bool node_terms = true) const;
 
   const Block* block_;
   double h1_, h2_;
   RestState rest_;
+  Quadrature quadrature_;
   energy::InteriorCoefficients interior_;
   energy::Terms terms_;
   std::vector<RowScratch> scratch_;  // one per thread, sized by the first internal_force

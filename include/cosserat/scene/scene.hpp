@@ -61,7 +61,10 @@ struct Fix {
 
 struct Load {
   NodeSet nodes;
-  Vec3 force;  // newtons on each node (MODEL.md §1)
+  // Newtons on each node (docs/equations.md §1); with `per_area`, newtons per square metre of
+  // rest area, each node taking it times its dual area (docs/scene-format.md, "Fixes and loads").
+  Vec3 force;
+  bool per_area = false;
   Window window;
 };
 

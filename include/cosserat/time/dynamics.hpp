@@ -33,7 +33,7 @@ class Dynamics {
   // Whether free_acceleration_rows can stand for free_acceleration: the energy form without a
   // fluid, whose terms need every row's normals before any row's acceleration is complete.
   bool fuses_rows() const {
-    return discretisation_ == Discretisation::energy && !fluid_.has_value();
+    return is_energy_form(discretisation_) && !fluid_.has_value();
   }
   // The velocity terms free_acceleration would return; with fuses_rows() only.
   VelocityTerms row_velocity_terms() const {
@@ -75,9 +75,10 @@ class Dynamics {
   void energy_density(const Field<Vec3>& r, Field<double>& density) const {
     energy_.energy_density(r, density);
   }
-  // The mass a node carries (kg): μ0 h1 h2 in the energy form (MODEL.md §2.5), M/(m n) in the
-  // flux form's diagnostics.
-  double node_mass() const { return node_mass_; }
+  // The masses the nodes carry (kg): μ0 h1 h2 times the node's share of the dual area in the
+  // energy forms (docs/model.md, "Energy quadrature"; the share is 1 at every node of the nodal
+  // quadrature), M/(m n) at every node in the flux form's diagnostics.
+  const NodeMass& node_mass() const { return node_mass_; }
 
   bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
   double rest_area() const { return rest_area_; }
@@ -102,7 +103,7 @@ class Dynamics {
   double area_quantum_;
   double mass_;
   double rest_area_;
-  double node_mass_;
+  NodeMass node_mass_;
   Vec3 gravity_;
   double damping_;
   std::optional<Fluid> fluid_;

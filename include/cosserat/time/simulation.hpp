@@ -27,10 +27,10 @@ struct ContactSummary {
 
 struct Diagnostics {
   double area_ratio = 0.0;      // S / S0
-  double kinetic_energy = 0.0;        // ½ Σ m |v|², m = Dynamics::node_mass()
+  double kinetic_energy = 0.0;        // ½ Σ m |v|², m of each node from Dynamics::node_mass()
   double gravitational_energy = 0.0;  // −Σ m g·r
   double max_speed = 0.0;
-  Vec3 center_of_mass;                // mean node position
+  Vec3 center_of_mass;                // Σ m r / Σ m
 };
 
 class Simulation {
@@ -57,7 +57,7 @@ class Simulation {
   double time() const { return stepper_.time(); }
   const Block& block() const { return block_; }
   // The lumped mass of every node (kg).
-  double node_mass() const { return dynamics_.node_mass(); }
+  const NodeMass& node_mass() const { return dynamics_.node_mass(); }
   const Field<Vec3>& positions() const { return stepper_.positions(); }
   const Field<Vec3>& velocities() { return stepper_.velocities(); }
   // Wall time this rank spent in halo exchanges so far.
