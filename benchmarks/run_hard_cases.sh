@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Hard cases of issue 11 (items 3 and 5) with both discretisations of the internal force
-# (model.discretisation = "flux" and "energy"): every preset on S2 for 10 s, the 1 m squares of
+# Hard cases of issue 11 (items 3 and 5) with the three discretisations of the internal force
+# (model.discretisation = "flux", "energy-nodal" and the default "energy", docs/model.md):
+# every preset on S2 for 10 s, the 1 m squares of
 # silk, cotton and denim hung from a corner, S6 with its loads x 5, S6 with xi = 0, S4 with the
 # flag preset and the 120 x 120 silk crumple (scenes/hard/). For each run: exit status, the time
 # it stopped and the stability monitor's message, wall time, the step, and the sheet's quality
@@ -93,7 +94,7 @@ jobs=$work/jobs
 : >"$jobs"
 for idx in "${!cases[@]}"; do
   IFS='|' read -r label scene steps extra <<<"${cases[$idx]}"
-  for disc in flux energy; do
+  for disc in flux energy-nodal energy; do
     printf '%s\0%s\0%s\0%s\0%s\0%s\0' "$idx" "$label" "$scene" "$steps" "$extra" "$disc" >>"$jobs"
   done
 done
@@ -123,7 +124,8 @@ fi
 import csv, glob, json, sys
 work, stem, date, cpu, compiler, revision, threads, total, quick, timeout, version = sys.argv[1:]
 rows = sorted((json.load(open(p)) for p in glob.glob(work + "/*.row.json")),
-              key=lambda r: (r["index"], r["discretisation"] != "flux"))
+              key=lambda r: (r["index"],
+                             ["flux", "energy-nodal", "energy"].index(r["discretisation"])))
 def g(r, k, fmt):
     q = r.get("quality") or {}
     v = q.get(k, r.get(k))
@@ -147,7 +149,7 @@ with open(stem + ".csv", "w", newline="") as f:
     w = csv.writer(f)
     w.writerow(cols)
     w.writerows(table)
-lines = [f"# Hard cases: flux against energy discretisation, {date}" + (" (QUICK: 1/10 of every run)" if quick == "1" else ""), "",
+lines = [f"# Hard cases: the flux, nodal energy and energy discretisations, {date}" + (" (QUICK: 1/10 of every run)" if quick == "1" else ""), "",
          f"Machine: {cpu}; compiler: {compiler}, release; git {revision}; binary `{version}`; "
          f"1 rank x {threads} thread(s), two runs at a time; per-run timeout {timeout} s.",
          f"`benchmarks/run_hard_cases.sh{' --quick' if quick == '1' else ''}`; whole suite {int(total) // 60} min {int(total) % 60} s of wall time. "

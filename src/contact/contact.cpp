@@ -223,7 +223,7 @@ struct Contact::Exchange {
 // A cell triangle pressed into a solid: its barycentric weights at the deepest point, the move
 // δ n of that point and the change of its velocity (CONTACT.md §2, "Between nodes").
 struct Contact::CellPush {
-  std::size_t triangle = 0;  // its index among the block's: 2 (cell index) + 0 or 1
+  std::size_t triangle = 0;  // its index among the block's: 4 (cell index) + 0 … 3
   std::array<double, 3> weights{};
   Vec3 move;
   Vec3 velocity_change;
@@ -567,11 +567,29 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
   for (const auto& row : exchange_rows_) out.insert(out.end(), row.begin(), row.end());
 }
 
-// CONTACT.md §2, between nodes: each triangle of a cell (diagonal from (k, l) to (k+1, l+1))
-// at its point deepest in the solid, moved out through its three nodes with weights
-// w_i = b_i / Σ b_j², so the point itself moves by δ n and its velocity by the response's
-// change. Triangles are found on the cells touching owned nodes, ghosts included, so each
-// node sums the pushes of its six triangles in one fixed order, whatever the decomposition.
+// The four triangles of cell (kc, lc), the two of each diagonal, so that the cells have every
+// mirror of the grid, k → m−1−k, l → n−1−l and (k, l) → (l, k), as the energy does
+// (docs/contact.md, "Symmetry"); one diagonal for every cell kept only the last, and a
+// diagonal that points to the grid's centre in each quadrant made nodes on a box's edge jitter
+// where the diagonals turn (tests/regression/test_contact_rest.cpp, measured).
+namespace {
+using TriangleCorners = std::array<std::array<int, 2>, 3>;
+constexpr int kCellTriangles = 4;
+TriangleCorners triangle_corners(int kc, int lc, int tri) {
+  switch (tri) {
+    case 0: return {{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}};
+    case 1: return {{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
+    case 2: return {{{kc + 1, lc}, {kc, lc}, {kc, lc + 1}}};
+    default: return {{{kc + 1, lc}, {kc + 1, lc + 1}, {kc, lc + 1}}};
+  }
+}
+}  // namespace
+
+// Between nodes (docs/contact.md, "Cells"): each triangle of a cell (triangle_corners) at its
+// point deepest in the solid, moved out through its three nodes with weights w_i = b_i / Σ b_j²,
+// so the point itself moves by δ n and its velocity by the response's change. Triangles are
+// found on the cells touching owned nodes, ghosts included, so each node sums the pushes of the
+// triangles of its four cells in one fixed order, whatever the decomposition.
 void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
                         Field<Vec3>& next, std::vector<Exchange>& out) {
   const Block& b = *block_;
@@ -668,11 +686,12 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
     }
   const int width = b.owned_k() + 1;
   const auto triangle = [&](int kc, int lc, int tri) {
-    return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * 2 +
+    return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * kCellTriangles +
            static_cast<std::size_t>(tri);
   };
-  if (slot_.size() != static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2)
-    slot_.assign(static_cast<std::size_t>(width) * (b.owned_l() + 1) * 2, -1);
+  const std::size_t triangles =
+      static_cast<std::size_t>(width) * (b.owned_l() + 1) * kCellTriangles;
+  if (slot_.size() != triangles) slot_.assign(triangles, -1);
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j) {
     std::vector<CellPush>& pushes = push_rows_[static_cast<std::size_t>(j)];
@@ -682,12 +701,8 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       const TileRange cells = tile_cell_nodes(i, j);
       for (int lc = cells.l0; lc < cells.l1; ++lc)
         for (int kc = cells.k0; kc < cells.k1; ++kc)
-          for (int tri = 0; tri < 2; ++tri) {
-            // Corners of the two triangles, ordered so that the grid's mirror (k, l) → (l, k)
-            // maps one triangle onto the other with its corners in the same order.
-            using Corners = std::array<std::array<int, 2>, 3>;
-            const Corners nodes = tri == 0 ? Corners{{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}}
-                                           : Corners{{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
+          for (int tri = 0; tri < kCellTriangles; ++tri) {
+            const TriangleCorners nodes = triangle_corners(kc, lc, tri);
             double nearest = 1e300, longest = 0.0;
             for (int v = 0; v < 3; ++v) {
               nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
@@ -764,12 +779,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   for (const auto& row : push_rows_) cells_.insert(cells_.end(), row.begin(), row.end());
   if (cells_.empty()) return;
   for (std::size_t i = 0; i < cells_.size(); ++i) slot_[cells_[i].triangle] = static_cast<int>(i);
-  // The six triangles around node (k, l): (cell offset, triangle, the node's corner in it).
-  struct Around {
-    int dk, dl, tri, corner;
-  };
-  static constexpr std::array<Around, 6> around{
-      {{0, 0, 0, 0}, {0, 0, 1, 0}, {-1, 0, 0, 1}, {-1, -1, 0, 2}, {-1, -1, 1, 2}, {0, -1, 1, 1}}};
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j) {
     std::vector<Exchange>& exchanges = exchange_rows_[static_cast<std::size_t>(j)];
@@ -785,19 +794,27 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           // on a box's edge moved it up to six times too far, and the next step it fell back.
           Vec3 move, dv, normal, surface;
           int pushes = 0;
-          for (const Around& a : around) {
-            const int kc = k + a.dk, lc = l + a.dl;
-            if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
-            const int slot = slot_[triangle(kc, lc, a.tri)];
-            if (slot < 0) continue;
-            const CellPush& push = cells_[static_cast<std::size_t>(slot)];
-            const double weight = push.weights[static_cast<std::size_t>(a.corner)];
-            move += weight * push.move;
-            dv += weight * push.velocity_change;
-            normal += weight * push.normal;
-            surface += push.surface;
-            ++pushes;
-          }
+          for (int dl = -1; dl <= 0; ++dl)
+            for (int dk = -1; dk <= 0; ++dk) {
+              const int kc = k + dk, lc = l + dl;
+              if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
+              for (int tri = 0; tri < kCellTriangles; ++tri) {
+                const int slot = slot_[triangle(kc, lc, tri)];
+                if (slot < 0) continue;
+                const TriangleCorners corners = triangle_corners(kc, lc, tri);
+                std::size_t corner = 0;
+                while (corner < 3 && (corners[corner][0] != k || corners[corner][1] != l))
+                  ++corner;
+                if (corner == 3) continue;  // the triangle without this node
+                const CellPush& push = cells_[static_cast<std::size_t>(slot)];
+                const double weight = push.weights[corner];
+                move += weight * push.move;
+                dv += weight * push.velocity_change;
+                normal += weight * push.normal;
+                surface += push.surface;
+                ++pushes;
+              }
+            }
           if (pushes == 0 || dot(normal, normal) == 0.0) continue;
           const double share = 1.0 / pushes;
           Vec3& r = next(k, l);

@@ -49,7 +49,7 @@ struct Terms {
 // strain where its difference is centred (stretch on its edge, shear and twist on the cell,
 // bending at the node), with the trapezoidal rule's weights and masses from the dual areas;
 // the default. nodal: every strain at its node from one-sided differences, every node weighted
-// alike (the form of MODEL.md §2.5 that was the default until 2026-12).
+// alike (docs/equations.md, "Nodal quadrature"; the default until 2026-12).
 enum class Quadrature { trapezoidal, nodal };
 
 class CosseratEnergy {
