@@ -408,7 +408,11 @@ def colour_scale(field, values):
         return Normalize(-reach, reach)
     low = float(every.min())
     high = float(np.percentile(every, 99) if field.robust else every.max())
-    return Normalize(low, high if high > low else low + 1.0)
+    # Values equal but for round-off (a sheet lying flat: heights 4e-16 m apart) would spread
+    # over the whole colour bar as a gradient that is not there; they take its middle colour.
+    if high - low <= 1e-12 * max(abs(low), abs(high), 1.0):
+        return Normalize(low - 0.5, low + 0.5)
+    return Normalize(low, high)
 
 
 def animation_frames(frames, most):
