@@ -179,11 +179,11 @@ void check_every_fabric(int cells, double tolerance) {
     }
 }
 
-// 8 cells over l = 2c, 4.5 nodes per bending length: +0.11 to +0.21 % off c, against −0.12 to
-// +0.05 % at 16 cells and −0.21 to +0.00 % at 32, where all but navy-sparkle-sweat along x² are
-// within 0.03 % (that one stretches by 1.3 %; docs/materials.md, "The cantilever check"). The
-// tolerance, 0.5 %, is more than twice the largest of these: 1.5 % of B or of μ₀, 0.35° of the
-// chord.
+// 8 cells over l = 2c, 4.5 nodes per bending length: −0.06 to +0.05 % off c, against −0.17 to
+// −0.00 % at 16 cells and −0.23 to −0.01 % at 32, where all but navy-sparkle-sweat are within
+// 0.05 % (that one stretches by 1.3 % along x²; docs/materials.md, "The cantilever check";
+// measured 2026-12-02 with the trapezoidal quadrature). The tolerance, 0.5 %, is more than twice
+// the largest of these: 1.5 % of B or of μ₀, 0.35° of the chord.
 TEST(BendingLength, MeasuredFabricsDroopAsTheirPresetsSay) {
   // The elastica overhanging by twice its bending length: the standards' 41.5°.
   EXPECT_NEAR(Elastica{8.0}.chord_angle() * 180 / std::numbers::pi, 41.49, 0.005);
