@@ -575,7 +575,7 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
 namespace {
 using TriangleCorners = std::array<std::array<int, 2>, 3>;
 constexpr int kCellTriangles = 4;
-TriangleCorners triangle_corners(int kc, int lc, int tri) {
+constexpr TriangleCorners triangle_corners(int kc, int lc, int tri) {
   switch (tri) {
     case 0: return {{{kc, lc}, {kc + 1, lc}, {kc + 1, lc + 1}}};
     case 1: return {{{kc, lc}, {kc, lc + 1}, {kc + 1, lc + 1}}};
@@ -583,6 +583,29 @@ TriangleCorners triangle_corners(int kc, int lc, int tri) {
     default: return {{{kc + 1, lc}, {kc + 1, lc + 1}, {kc, lc + 1}}};
   }
 }
+
+// The twelve triangles around a node, (cell offset, triangle, the node's corner in it), in the
+// order a node sums their pushes: cells (dk, dl) with dl, then dk, from −1 to 0, triangles in
+// order. Derived from triangle_corners once, at compile time.
+struct Around {
+  int dk, dl, tri, corner;
+};
+constexpr std::array<Around, 12> triangles_around() {
+  std::array<Around, 12> around{};
+  std::size_t i = 0;
+  for (int dl = -1; dl <= 0; ++dl)
+    for (int dk = -1; dk <= 0; ++dk)
+      for (int tri = 0; tri < kCellTriangles; ++tri) {
+        const TriangleCorners corners = triangle_corners(dk, dl, tri);
+        for (int corner = 0; corner < 3; ++corner)
+          if (corners[corner][0] == 0 && corners[corner][1] == 0)
+            around[i++] = {dk, dl, tri, corner};
+      }
+  // Reached at compile time only if the triangles did not cover each corner three times.
+  if (i != around.size()) throw "a node must lie in three triangles of each of its cells";
+  return around;
+}
+constexpr std::array<Around, 12> kAround = triangles_around();
 }  // namespace
 
 // Between nodes (docs/contact.md, "Cells"): each triangle of a cell (triangle_corners) at its
@@ -794,27 +817,19 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           // on a box's edge moved it up to six times too far, and the next step it fell back.
           Vec3 move, dv, normal, surface;
           int pushes = 0;
-          for (int dl = -1; dl <= 0; ++dl)
-            for (int dk = -1; dk <= 0; ++dk) {
-              const int kc = k + dk, lc = l + dl;
-              if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
-              for (int tri = 0; tri < kCellTriangles; ++tri) {
-                const int slot = slot_[triangle(kc, lc, tri)];
-                if (slot < 0) continue;
-                const TriangleCorners corners = triangle_corners(kc, lc, tri);
-                std::size_t corner = 0;
-                while (corner < 3 && (corners[corner][0] != k || corners[corner][1] != l))
-                  ++corner;
-                if (corner == 3) continue;  // the triangle without this node
-                const CellPush& push = cells_[static_cast<std::size_t>(slot)];
-                const double weight = push.weights[corner];
-                move += weight * push.move;
-                dv += weight * push.velocity_change;
-                normal += weight * push.normal;
-                surface += push.surface;
-                ++pushes;
-              }
-            }
+          for (const Around& a : kAround) {
+            const int kc = k + a.dk, lc = l + a.dl;
+            if (kc < 0 || lc < 0 || kc >= b.m - 1 || lc >= b.n - 1) continue;
+            const int slot = slot_[triangle(kc, lc, a.tri)];
+            if (slot < 0) continue;
+            const CellPush& push = cells_[static_cast<std::size_t>(slot)];
+            const double weight = push.weights[static_cast<std::size_t>(a.corner)];
+            move += weight * push.move;
+            dv += weight * push.velocity_change;
+            normal += weight * push.normal;
+            surface += push.surface;
+            ++pushes;
+          }
           if (pushes == 0 || dot(normal, normal) == 0.0) continue;
           const double share = 1.0 / pushes;
           Vec3& r = next(k, l);
