@@ -38,6 +38,47 @@ SCENES = [("S1", "s1_clothesline.toml"), ("S2", "s2_cape.toml"), ("S3", "s3_benc
 SIZE = 10.0  # the sheet's side (m): distances are reported relative to it
 
 
+
+def s1_like_scene(nodes, dt, steps, every, support):
+    """S1's sheet, material and environment on a nodes x nodes grid (nodes = 9 * 2^j + 1),
+    held throughout (S1's fix window, 20 001 steps, outlasts its run; here it has no end so
+    that no dt releases it) by
+      corners   S1's supports: the corner nodes [0, 0] and [0, nodes-1] of the x1 = 0 edge;
+      segments  the x1 = 0 edge from each of those corners to the next node of the 10 x 10
+                grid (10/9 m at each end), the same support on every grid;
+    with "-undamped" appended, without S1's medium damping (the forms' damping differs by
+    the area ratio S/S0: the flux form's μ = M/S is the current one, the energy form's μ0
+    = M/S0 the rest one)."""
+    damping = 0.0 if support.endswith("-undamped") else 0.2
+    if support.startswith("corners"):
+        fix = f"[[fix]]\nnodes = [[0, 0], [0, {nodes - 1}]]\n"
+    else:
+        s = (nodes - 1) // 9
+        fix = (f"[[fix]]\nregion = {{ rect = [0, 0, 0, {s}] }}\n"
+               f"[[fix]]\nregion = {{ rect = [0, {nodes - 1 - s}, 0, {nodes - 1}] }}\n")
+    return f"""title = "S1-like sheet {nodes} x {nodes}"
+[grid]
+nodes = [{nodes}, {nodes}]
+size = [{SIZE}, {SIZE}]
+origin = [0.0, 0.0, 0.0]
+u = [1.0, 0.0, 0.0]
+v = [0.0, 0.0, 1.0]
+[material]
+mass = 10.0
+zeta = 100.0
+xi = 0.3
+phi = 0.001
+[environment]
+gravity = [0.0, -9.8, 0.0]
+damping = {damping!r}
+[time]
+integrator = "verlet"
+dt = {dt!r}
+steps = {steps}
+output_every = {every}
+{fix}"""
+
+
 class Study:
     def __init__(self, args):
         self.exe = args.exe
@@ -84,44 +125,9 @@ class Study:
 
     # ------------------------------------------------------------------------------------------
     def sheet(self, nodes, dt, steps, every, support):
-        """S1's sheet, material and environment on a nodes x nodes grid (nodes = 9 * 2^j + 1),
-        held throughout (S1's fix window, 20 001 steps, outlasts its run; here it has no end so
-        that no dt releases it) by
-          corners   S1's supports: the corner nodes [0, 0] and [0, nodes-1] of the x1 = 0 edge;
-          segments  the x1 = 0 edge from each of those corners to the next node of the 10 x 10
-                    grid (10/9 m at each end), the same support on every grid;
-        with "-undamped" appended, without S1's medium damping (the forms' damping differs by
-        the area ratio S/S0: the flux form's μ = M/S is the current one, the energy form's μ0
-        = M/S0 the rest one)."""
-        damping = 0.0 if support.endswith("-undamped") else 0.2
-        if support.startswith("corners"):
-            fix = f"[[fix]]\nnodes = [[0, 0], [0, {nodes - 1}]]\n"
-        else:
-            s = (nodes - 1) // 9
-            fix = (f"[[fix]]\nregion = {{ rect = [0, 0, 0, {s}] }}\n"
-                   f"[[fix]]\nregion = {{ rect = [0, {nodes - 1 - s}, 0, {nodes - 1}] }}\n")
+        """The S1-like scene (s1_like_scene) written to a file of the work folder."""
         path = self.work / f"sheet-{support}-{nodes}-{dt!r}.toml"
-        path.write_text(f"""title = "S1-like sheet {nodes} x {nodes}"
-[grid]
-nodes = [{nodes}, {nodes}]
-size = [{SIZE}, {SIZE}]
-origin = [0.0, 0.0, 0.0]
-u = [1.0, 0.0, 0.0]
-v = [0.0, 0.0, 1.0]
-[material]
-mass = 10.0
-zeta = 100.0
-xi = 0.3
-phi = 0.001
-[environment]
-gravity = [0.0, -9.8, 0.0]
-damping = {damping!r}
-[time]
-integrator = "verlet"
-dt = {dt!r}
-steps = {steps}
-output_every = {every}
-{fix}""")
+        path.write_text(s1_like_scene(nodes, dt, steps, every, support))
         return str(path)
 
     def run(self, job):

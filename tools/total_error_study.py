@@ -41,7 +41,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from parity_study import write_csv
+from parity_study import s1_like_scene, write_csv
 
 DISCS = ["energy", "energy-nodal"]
 LABEL = {"energy": "trapezoidal (\"energy\")", "energy-nodal": "nodal (\"energy-nodal\")"}
@@ -326,34 +326,10 @@ region = {{ column = {n - 1} }}
     # ------------------------------------------------------------------------------------------
     # S1-like sheet
     def s1_scene(self, n, dt, steps):
-        s = (n - 1) // 9
-        return self.scene(f"""title = "S1-like sheet {n} x {n}, segment supports"
-[grid]
-nodes = [{n}, {n}]
-size = [10.0, 10.0]
-origin = [0.0, 0.0, 0.0]
-u = [1.0, 0.0, 0.0]
-v = [0.0, 0.0, 1.0]
-[material]
-mass = 10.0
-zeta = 100.0
-xi = 0.3
-phi = 0.001
-[environment]
-gravity = [0.0, -9.8, 0.0]
-damping = 0.2
-[time]
-integrator = "verlet"
-dt = {dt!r}
-steps = {steps}
-output_every = {steps}
-[output]
-fields = []
-[[fix]]
-region = {{ rect = [0, 0, 0, {s}] }}
-[[fix]]
-region = {{ rect = [0, {n - 1 - s}, 0, {n - 1}] }}
-""")
+        """tools/parity_study.py's S1-like sheet on its segment supports, the last frame only,
+        no fields."""
+        return self.scene(s1_like_scene(n, dt, steps, steps, "segments")
+                          + "[output]\nfields = []\n")
 
     def s1(self, args):
         duration = args.s1_time

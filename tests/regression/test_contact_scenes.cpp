@@ -102,14 +102,17 @@ TEST_P(CubeRebound, TheCubeRisesStraightBack) {
   EXPECT_LT(offset, 1e-9);
 }
 
+// A test's name from its scene file: the file name without ".toml".
+std::string file_stem(const std::string& file) { return file.substr(0, file.find('.')); }
+
 INSTANTIATE_TEST_SUITE_P(Contact, CubeRebound,
                          ::testing::Values("cube_net_25.toml", "cube_net_500.toml"),
                          [](const ::testing::TestParamInfo<std::string>& info) {
-                           return info.param.substr(0, info.param.find('.'));
+                           return file_stem(info.param);
                          });
 
 std::string scene_test_name(const ::testing::TestParamInfo<ContactScene>& info) {
-  return info.param.file.substr(0, info.param.file.find('.'));
+  return file_stem(info.param.file);
 }
 
 INSTANTIATE_TEST_SUITE_P(
