@@ -3,6 +3,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "energy_interior.hpp"
@@ -33,21 +34,23 @@ inline Terms terms_of(const Neighbours& p) {
 }
 
 // The unit normal n = s/|s| of §2.1 rule 2, s the sum of the unit normals of p's corner
-// triangles, with what its gradient needs: computed once per node for both. The arithmetic is
-// geometry::unit_normal's, so n is the same bits.
+// triangles, with what its gradient needs: computed once per node for both. Each unit goes
+// through energy::bounded_unit (docs/equations.md, "Crushed cells"); where nothing is crushed
+// the arithmetic is geometry::unit_normal's, so n is the same bits.
 struct CornerNormals {
   struct Corner {
     int ek, el, fk, fl;  // the offsets of the corner's two edges' far nodes
     Vec3 E, F;           // the edges r_e − r, r_f − r
-    energy::Corner normal;
+    energy::Unit normal;
   };
   Corner corner[4];
   int count = 0;
-  double sum_length = 0.0;  // |s|
+  energy::Unit sum;  // n = sum.unit
   Vec3 n;
 };
 
-CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbours& p) {
+CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbours& p,
+                             const energy::InteriorCoefficients& coefficients) {
   const Vec3 r = R(k, l);
   CornerNormals c;
   auto add = [&](int ek, int el, int fk, int fl) {
@@ -55,7 +58,7 @@ CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbour
     q.ek = ek, q.el = el, q.fk = fk, q.fl = fl;
     q.E = R(k + ek, l + el) - r;
     q.F = R(k + fk, l + fl) - r;
-    q.normal = energy::corner(q.E, q.F);
+    q.normal = energy::corner(q.E, q.F, coefficients.corner);
   };
   if (p.right && p.up) add(1, 0, 0, 1);
   if (p.up && p.left) add(0, 1, -1, 0);
@@ -63,16 +66,16 @@ CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbour
   if (p.down && p.right) add(0, -1, 1, 0);
   Vec3 sum;
   for (int i = 0; i < c.count; ++i) sum += c.corner[i].normal.unit;
-  c.sum_length = norm(sum);
-  c.n = sum / c.sum_length;
+  c.sum = energy::bounded_unit(sum, coefficients.sum);
+  c.n = c.sum.unit;
   return c;
 }
 
 // Adds the gradient that flows back through n, given G_n = ∂E/∂n.
 void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
                          CosseratEnergy::StencilGradient& g) {
-  // d(s/|s|) projects out n and divides by |s|; then back through each corner's c/|c|.
-  const Vec3 G_s = (G_n - dot(G_n, c.n) * c.n) / c.sum_length;
+  // Back through n = s/g(|s|), then through each corner's unit.
+  const Vec3 G_s = energy::unit_gradient(c.sum, G_n);
   for (int i = 0; i < c.count; ++i) {
     const CornerNormals::Corner& q = c.corner[i];
     const energy::CornerGradient d = energy::corner_gradient(q.normal, q.E, q.F, G_s);
@@ -81,6 +84,10 @@ void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
     g[slot(0, 0)] -= d.e + d.f;
   }
 }
+
+// Below these a corner triangle or cell (as a fraction of its rest |c|) and a node's sum of
+// corner units count as crushed (docs/equations.md, "Crushed cells").
+constexpr double kCrushedFraction = 0.25, kCrushedSum = 0.5;
 
 bool any_nonzero(const Sym2& c) { return c[0] != 0.0 || c[1] != 0.0 || c[2] != 0.0; }
 
@@ -98,6 +105,15 @@ energy::InteriorCoefficients interior_coefficients(const Sym2& Phi, const Sym2& 
     c.mu_beta[i] = 2.0 * area * w[i] * Psi[i] / (H[i] * H[i]);
     c.mu_eps[i] = -area * w[i] * Theta[i] / H[i];
   }
+  // docs/equations.md, "Crushed cells": a corner triangle's |E × F| is h₁h₂√det A at rest, a
+  // cell's |t₁ × t₂| four times that, and a node's |s| up to 4.
+  auto crush = [](double delta) {
+    return energy::Crush{delta, delta * delta, 1.0 / (delta * delta)};
+  };
+  const double rest_corner = area * std::sqrt(A[0] * A[2] - A[1] * A[1]);
+  c.corner = crush(kCrushedFraction * rest_corner);
+  c.cell = crush(4.0 * kCrushedFraction * rest_corner);
+  c.sum = crush(kCrushedSum);
   return c;
 }
 
@@ -185,7 +201,7 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
 
   const bool needs_normal = (bend11 || bend22) || normal != nullptr;
   CornerNormals corners;
-  if (needs_normal) corners = corner_normals(R, k, l, p);
+  if (needs_normal) corners = corner_normals(R, k, l, p, interior_);
   if (normal != nullptr) *normal = corners.n;
   Vec3 G_n;  // ∂E_p/∂n
   auto bending = [&](bool exists, const Vec3& d, double h, double w, int i, double eps_f,
@@ -214,9 +230,8 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
     const Vec3 t1 = right + (diagonal - up), t2 = up + (diagonal - right);
     const Vec3 X = (diagonal - right) - up;
     const double eps12 = 0.5 * (dot(t1, t2) / (4.0 * area) - A[1]);
-    const Vec3 c = cross(t1, t2);
-    const double c_length = norm(c);
-    const Vec3 n = c / c_length;
+    const energy::Unit cell_unit = energy::corner(t1, t2, interior_.cell);
+    const Vec3 n = cell_unit.unit;
     const double kappa12 = -dot(n, X) / area;
     part.cell = 2.0 * area *
                 (Phi[1] * eps12 * eps12 + Psi[1] * kappa12 * kappa12 + Theta[1] * eps12 * kappa12);
@@ -226,7 +241,7 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
       // ε₁₂ = t₁ · t₂/(8a) − ½A₁₂; κ₁₂ = −n · X/a with n = c/|c|, c = t₁ × t₂.
       Vec3 G_t1 = (N12 / (8.0 * area)) * t2, G_t2 = (N12 / (8.0 * area)) * t1;
       const Vec3 G_X = (-M12 / area) * n, G_cn = (-M12 / area) * X;
-      const Vec3 G_c = (G_cn - dot(G_cn, n) * n) / c_length;
+      const Vec3 G_c = energy::unit_gradient(cell_unit, G_cn);
       G_t1 += cross(t2, G_c);
       G_t2 += cross(G_c, t1);
       // t₁ = r(k+1, l) + r(k+1, l+1) − r − r(k, l+1), t₂ = r(k, l+1) + r(k+1, l+1) − r − r(k+1, l).
@@ -264,7 +279,7 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   const Terms has = terms_of(p);
   const double h1 = h1_, h2 = h2_;
   const Tangents a = tangents(R, k, l, p, h1, h2);
-  const CornerNormals corners = corner_normals(R, k, l, p);
+  const CornerNormals corners = corner_normals(R, k, l, p, interior_);
   const Vec3 n = corners.n;
   if (normal != nullptr) *normal = n;
   const SecondDerivatives X = second_derivatives(R, k, l, p, h1, h2);

@@ -20,27 +20,45 @@ struct InteriorGradient {
   Vec3 centre, right, left, up, down, up_right;  // (0,0) (1,0) (−1,0) (0,1) (0,−1) (1,1)
 };
 
-// One corner triangle of §2.1 rule 2: edges E, F from p, c = E × F, its length and unit.
-struct Corner {
+// A vector c made a unit one, u = c/g, with g = |c| except where the triangle or cell c spans
+// is crushed, |c| < δ (docs/equations.md, "Crushed cells"): there g = δ (3/8 + ¾y − ⅛y²),
+// y = |c|²/δ², which meets |c| at δ with two matching derivatives and stays ≥ 3δ/8, so u
+// shrinks to zero with the triangle instead of turning at a rate 1/|c| and the stiffness of the
+// terms that read it stays bounded. Above δ the bits are those of c/|c|.
+struct Unit {
   Vec3 unit;
-  double length;
+  double inverse;  // 1/g
+  double rho;      // g g′(|c|)/|c|: 1 where c is not crushed
 };
 
-[[gnu::always_inline]] inline Corner corner(const Vec3& E, const Vec3& F) {
-  const Vec3 c = cross(E, F);
-  const double length = std::sqrt(dot(c, c));
-  return {c * (1.0 / length), length};
+[[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush) {
+  const double length2 = dot(c, c);
+  const double y = length2 * crush.inverse_delta2;
+  const bool crushed = length2 < crush.delta2;
+  const double blend = 0.375 + y * (0.75 - 0.125 * y);
+  const double inverse = 1.0 / (crushed ? crush.delta * blend : std::sqrt(length2));
+  return {c * inverse, inverse, crushed ? 0.5 * blend * (3.0 - y) : 1.0};
 }
 
-// Back through a corner's c/|c| and c = E × F: ∂/∂r of G_s · (c/|c|) at its edges' far nodes;
-// at p it is minus their sum.
+// Back through u = c/g: ∂/∂c of G_u · u.
+[[gnu::always_inline]] inline Vec3 unit_gradient(const Unit& u, const Vec3& G_u) {
+  return (G_u - (u.rho * dot(G_u, u.unit)) * u.unit) * u.inverse;
+}
+
+// One corner triangle of §2.1 rule 2: edges E, F from p and the unit of c = E × F.
+[[gnu::always_inline]] inline Unit corner(const Vec3& E, const Vec3& F, const Crush& crush) {
+  return bounded_unit(cross(E, F), crush);
+}
+
+// Back through a corner's unit and c = E × F: ∂/∂r of G_s · u at its edges' far nodes; at p it
+// is minus their sum.
 struct CornerGradient {
   Vec3 e, f;
 };
 
-[[gnu::always_inline]] inline CornerGradient corner_gradient(const Corner& q, const Vec3& E,
+[[gnu::always_inline]] inline CornerGradient corner_gradient(const Unit& q, const Vec3& E,
                                                              const Vec3& F, const Vec3& G_s) {
-  const Vec3 G_c = (G_s - dot(G_s, q.unit) * q.unit) * (1.0 / q.length);
+  const Vec3 G_c = unit_gradient(q, G_s);
   // G_c · (δE × F) = δE · (F × G_c), G_c · (E × δF) = δF · (G_c × E).
   return {cross(F, G_c), cross(G_c, E)};
 }
@@ -62,13 +80,13 @@ template <bool Bending, bool Coupling, bool Normal>
   double nu11 = c.nu_eps[0] * eps11, nu12 = c.nu_eps[1] * eps12, nu22 = c.nu_eps[2] * eps22;
 
   if (Bending || Normal) {
-    // §2.1 rule 2: n = s/|s|, s the sum of the four corner triangles' unit normals.
+    // §2.1 rule 2: n = s/|s|, s the sum of the four corner triangles' unit normals (each
+    // through bounded_unit).
     const Vec3 left = r_left - r, down = r_down - r;
-    const Corner q0 = corner(right, up), q1 = corner(up, left), q2 = corner(left, down),
-                 q3 = corner(down, right);
-    const Vec3 s = ((q0.unit + q1.unit) + q2.unit) + q3.unit;
-    const double s_length = std::sqrt(dot(s, s));
-    const Vec3 n = s * (1.0 / s_length);
+    const Unit q0 = corner(right, up, c.corner), q1 = corner(up, left, c.corner),
+               q2 = corner(left, down, c.corner), q3 = corner(down, right, c.corner);
+    const Unit sum = bounded_unit(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum);
+    const Vec3 n = sum.unit;
     normal = n;
 
     if (Bending) {
@@ -94,8 +112,8 @@ template <bool Bending, bool Coupling, bool Normal>
       g_up_right = G_X12;
       const Vec3 G_n = (mu11 * d11 + mu22 * d22) + mu12 * d12;
 
-      // Back through n = s/|s|, then through each corner's unit normal.
-      const Vec3 G_s = (G_n - dot(G_n, n) * n) * (1.0 / s_length);
+      // Back through n = s/g(|s|), then through each corner's unit normal.
+      const Vec3 G_s = unit_gradient(sum, G_n);
       const CornerGradient g0 = corner_gradient(q0, right, up, G_s),
                            g1 = corner_gradient(q1, up, left, G_s),
                            g2 = corner_gradient(q2, left, down, G_s),
@@ -140,11 +158,10 @@ template <bool Bending, bool Coupling, bool Normal>
 
   if (Bending || Normal) {
     const Vec3 left = r_left - r, down = r_down - r;
-    const Corner q0 = corner(right, up), q1 = corner(up, left), q2 = corner(left, down),
-                 q3 = corner(down, right);
-    const Vec3 s = ((q0.unit + q1.unit) + q2.unit) + q3.unit;
-    const double s_length = std::sqrt(dot(s, s));
-    const Vec3 n = s * (1.0 / s_length);
+    const Unit q0 = corner(right, up, c.corner), q1 = corner(up, left, c.corner),
+               q2 = corner(left, down, c.corner), q3 = corner(down, right, c.corner);
+    const Unit sum = bounded_unit(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum);
+    const Vec3 n = sum.unit;
     normal = n;
 
     if (Bending) {
@@ -169,7 +186,7 @@ template <bool Bending, bool Coupling, bool Normal>
       g_up = G_X22;
       g_down = G_X22 + nu22_b * down;
       const Vec3 G_n = mu11 * d11 + mu22 * d22;
-      const Vec3 G_s = (G_n - dot(G_n, n) * n) * (1.0 / s_length);
+      const Vec3 G_s = unit_gradient(sum, G_n);
       const CornerGradient g0 = corner_gradient(q0, right, up, G_s),
                            g1 = corner_gradient(q1, up, left, G_s),
                            g2 = corner_gradient(q2, left, down, G_s),
@@ -185,7 +202,7 @@ template <bool Bending, bool Coupling, bool Normal>
 
       // The cell's twist: κ₁₂ = −n_c · X/(h₁h₂), n_c = t₁ × t₂ normalised.
       const Vec3 X = (diagonal - right) - up;
-      const Corner cell = corner(t1, t2);
+      const Unit cell = corner(t1, t2, c.cell);
       const double beta12 = dot(cell.unit, X);
       double mu12 = c.mu_beta[1] * beta12;
       if (Coupling) {

@@ -26,6 +26,13 @@ namespace energy {
 //   ν_i = area (2Φ_i ε_i + Θ_i κ_i) / H_i      (∂E_p/∂(D_α · D_β), times 2 for i = 11, 22),
 //   μ_i = ∂E_p/∂β_i = −area w_i (2Ψ_i κ_i + Θ_i ε_i) / H_i.
 // Built once from the moduli by interior_coefficients in cosserat_energy.cpp.
+//
+// The thresholds below which a vector the normals are made from counts as crushed
+// (docs/equations.md, "Crushed cells"): δ, δ² and 1/δ².
+struct Crush {
+  double delta, delta2, inverse_delta2;
+};
+
 struct InteriorCoefficients {
   Sym2 e;          // 1/(2H_i)
   Sym2 half_A;     // ½A_i
@@ -33,6 +40,9 @@ struct InteriorCoefficients {
   Sym2 nu_beta;
   Sym2 mu_beta;    // μ_i = mu_beta_i β_i + mu_eps_i ε_i
   Sym2 mu_eps;
+  Crush corner;  // c = E × F of a corner triangle
+  Crush cell;    // c = t₁ × t₂ of a cell (the trapezoidal twist)
+  Crush sum;     // s, the sum of a node's corner units
 };
 
 // The terms a material switches off: ξ = 0 and φ = 0 leave no curvature term at all (Ψ = Θ =
