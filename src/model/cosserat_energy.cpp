@@ -108,7 +108,7 @@ energy::InteriorCoefficients interior_coefficients(const Sym2& Phi, const Sym2& 
   // docs/equations.md, "Crushed cells": a corner triangle's |E × F| is h₁h₂√det A at rest, a
   // cell's |t₁ × t₂| four times that, and a node's |s| up to 4.
   auto crush = [](double delta) {
-    return energy::Crush{delta, delta * delta, 1.0 / (delta * delta)};
+    return energy::Crush{delta, 1.0 / (delta * delta)};
   };
   const double rest_corner = area * std::sqrt(A[0] * A[2] - A[1] * A[1]);
   c.corner = crush(kCrushedFraction * rest_corner);
@@ -230,7 +230,7 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
     const Vec3 t1 = right + (diagonal - up), t2 = up + (diagonal - right);
     const Vec3 X = (diagonal - right) - up;
     const double eps12 = 0.5 * (dot(t1, t2) / (4.0 * area) - A[1]);
-    const energy::Unit cell_unit = energy::corner(t1, t2, interior_.cell);
+    const energy::Unit cell_unit = energy::bounded_unit(cross(t1, t2), interior_.cell);
     const Vec3 n = cell_unit.unit;
     const double kappa12 = -dot(n, X) / area;
     part.cell = 2.0 * area *
@@ -238,7 +238,7 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
     if (G != nullptr) {
       const double N12 = 2.0 * area * (2.0 * Phi[1] * eps12 + Theta[1] * kappa12);
       const double M12 = 2.0 * area * (2.0 * Psi[1] * kappa12 + Theta[1] * eps12);
-      // ε₁₂ = t₁ · t₂/(8a) − ½A₁₂; κ₁₂ = −n · X/a with n = c/|c|, c = t₁ × t₂.
+      // ε₁₂ = t₁ · t₂/(8a) − ½A₁₂; κ₁₂ = −n · X/a with n = c/g(|c|), c = t₁ × t₂.
       Vec3 G_t1 = (N12 / (8.0 * area)) * t2, G_t2 = (N12 / (8.0 * area)) * t1;
       const Vec3 G_X = (-M12 / area) * n, G_cn = (-M12 / area) * X;
       const Vec3 G_c = energy::unit_gradient(cell_unit, G_cn);

@@ -34,7 +34,7 @@ struct Unit {
 [[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush) {
   const double length2 = dot(c, c);
   const double y = length2 * crush.inverse_delta2;
-  const bool crushed = length2 < crush.delta2;
+  const bool crushed = y < 1.0;
   const double blend = 0.375 + y * (0.75 - 0.125 * y);
   const double inverse = 1.0 / (crushed ? crush.delta * blend : std::sqrt(length2));
   return {c * inverse, inverse, crushed ? 0.5 * blend * (3.0 - y) : 1.0};
@@ -202,7 +202,7 @@ template <bool Bending, bool Coupling, bool Normal>
 
       // The cell's twist: κ₁₂ = −n_c · X/(h₁h₂), n_c = t₁ × t₂ normalised.
       const Vec3 X = (diagonal - right) - up;
-      const Unit cell = corner(t1, t2, c.cell);
+      const Unit cell = bounded_unit(cross(t1, t2), c.cell);
       const double beta12 = dot(cell.unit, X);
       double mu12 = c.mu_beta[1] * beta12;
       if (Coupling) {

@@ -43,6 +43,33 @@ void fill_with_ghosts(const Block& b, Field<Vec3>& r, Position position) {
       r(k, l) = position(k, l);
 }
 
+// −∂E/∂r_c at node (k, l) by a central difference of the sheet's energy with the given step.
+double minus_difference(Sheet& sheet, int k, int l, int c, double step) {
+  const double kept = sheet.r(k, l)[c];
+  sheet.r(k, l)[c] = kept + step;
+  const double up = sheet.total();
+  sheet.r(k, l)[c] = kept - step;
+  const double down = sheet.total();
+  sheet.r(k, l)[c] = kept;
+  return -(up - down) / (2.0 * step);
+}
+
+// The force at (k, l) by its definition, f_q = −Σ_p ∂E_p/∂r_q, with every gradient from
+// node_energy at the nodes p of q's stencil that lie in the grid.
+Vec3 force_from_node_gradients(const CosseratEnergy& energy, const Field<Vec3>& r,
+                               const Block& b, int k, int l) {
+  Vec3 force;
+  for (int dl = -1; dl <= 1; ++dl)
+    for (int dk = -1; dk <= 1; ++dk) {
+      const int pk = k + dk, pl = l + dl;
+      if (pk < 0 || pk >= b.m || pl < 0 || pl >= b.n) continue;
+      CosseratEnergy::StencilGradient g;
+      energy.node_energy(r, pk, pl, &g);
+      force -= g[3 * (1 - dl) + (1 - dk)];
+    }
+  return force;
+}
+
 constexpr Quadrature kQuadratures[] = {Quadrature::trapezoidal, Quadrature::nodal};
 
 const char* name(Quadrature q) { return q == Quadrature::trapezoidal ? "trapezoidal" : "nodal"; }
@@ -118,13 +145,7 @@ TEST(EnergyForm, ForceIsMinusTheGradientOfTheEnergy) {
   for (int l = 0; l < sheet.scene.n; ++l)
     for (int k = 0; k < sheet.scene.m; ++k)
       for (int c = 0; c < 3; ++c) {
-        const double kept = sheet.r(k, l)[c];
-        sheet.r(k, l)[c] = kept + step;
-        const double up = sheet.total();
-        sheet.r(k, l)[c] = kept - step;
-        const double down = sheet.total();
-        sheet.r(k, l)[c] = kept;
-        const double expected = -(up - down) / (2.0 * step);
+        const double expected = minus_difference(sheet, k, l, c, step);
         worst = std::max(worst, std::abs(force(k, l)[c] - expected));
         largest = std::max(largest, std::abs(expected));
       }
@@ -180,15 +201,7 @@ TEST(EnergyForm, RowKernelAgreesWithTheNodeGradients) {
         double worst = 0.0, largest = 0.0, worst_normal = 0.0;
         for (int l = b.l0; l < b.l1; ++l)
           for (int k = b.k0; k < b.k1; ++k) {
-            Vec3 expected;
-            for (int dl = -1; dl <= 1; ++dl)
-              for (int dk = -1; dk <= 1; ++dk) {
-                const int pk = k + dk, pl = l + dl;
-                if (pk < 0 || pk >= b.m || pl < 0 || pl >= b.n) continue;
-                CosseratEnergy::StencilGradient g;
-                energy.node_energy(r, pk, pl, &g);
-                expected -= g[3 * (1 - dl) + (1 - dk)];
-              }
+            const Vec3 expected = force_from_node_gradients(energy, r, b, k, l);
             worst = std::max(worst, norm(force(k, l) - expected));
             largest = std::max(largest, norm(expected));
             if (with_normals) {
@@ -247,24 +260,10 @@ TEST(EnergyForm, ForceIsTheGradientWhereCellsAreCrushed) {
     double worst = 0.0, largest = 0.0, worst_kernel = 0.0;
     for (int l = 0; l < sheet.scene.n; ++l)
       for (int k = 0; k < sheet.scene.m; ++k) {
-        Vec3 expected;
-        for (int dl = -1; dl <= 1; ++dl)
-          for (int dk = -1; dk <= 1; ++dk) {
-            const int pk = k + dk, pl = l + dl;
-            if (pk < 0 || pk >= sheet.scene.m || pl < 0 || pl >= sheet.scene.n) continue;
-            CosseratEnergy::StencilGradient g;
-            sheet.energy.node_energy(sheet.r, pk, pl, &g);
-            expected -= g[3 * (1 - dl) + (1 - dk)];
-          }
+        const Vec3 expected = force_from_node_gradients(sheet.energy, sheet.r, sheet.block, k, l);
         worst_kernel = std::max(worst_kernel, norm(force(k, l) - expected));
         for (int c = 0; c < 3; ++c) {
-          const double kept = sheet.r(k, l)[c];
-          sheet.r(k, l)[c] = kept + step;
-          const double up = sheet.total();
-          sheet.r(k, l)[c] = kept - step;
-          const double down = sheet.total();
-          sheet.r(k, l)[c] = kept;
-          const double difference = -(up - down) / (2.0 * step);
+          const double difference = minus_difference(sheet, k, l, c, step);
           worst = std::max(worst, std::abs(force(k, l)[c] - difference));
           largest = std::max(largest, std::abs(difference));
         }

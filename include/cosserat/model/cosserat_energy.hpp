@@ -28,9 +28,9 @@ namespace energy {
 // Built once from the moduli by interior_coefficients in cosserat_energy.cpp.
 //
 // The thresholds below which a vector the normals are made from counts as crushed
-// (docs/equations.md, "Crushed cells"): δ, δ² and 1/δ².
+// (docs/equations.md, "Crushed cells"): δ and 1/δ².
 struct Crush {
-  double delta, delta2, inverse_delta2;
+  double delta, inverse_delta2;
 };
 
 struct InteriorCoefficients {
