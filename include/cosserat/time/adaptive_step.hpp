@@ -1,7 +1,8 @@
 #pragma once
-// Adaptive steps (docs/stability.md, "Adaptive steps"): the step follows the stability estimate
-// of the current state times a safety factor, is cut to land on the frame times, and shrinks
-// after the monitor of MODEL.md §4.2 trips and the run rolls back. Every choice is made from
+// Adaptive steps (docs/stability.md, "Adaptive steps"): the rest of each frame in equal steps
+// that the stability estimate of the current state times a safety factor allows, changed only
+// when the estimate moves by more than a tenth, and shrunk after the monitor
+// (docs/stability.md) trips and the run rolls back. Every choice is made from
 // global maxima, which are exact, so the steps are the same on any number of ranks.
 
 #include "cosserat/scene/scene.hpp"
