@@ -29,9 +29,9 @@ TEST(FusedRows, AreTheFieldsAccelerationBitForBit) {
   scene.damping = 0.3;
   // Two loads on one node, whose order of summation must be kept, one on another row, and one
   // whose window is over at step 5.
-  Load first{{{{3, 4}, {20, 11}}}, {0.5, -0.25, 0.125}, {}};
-  Load second{{{{3, 4}}}, {1e-3, 7.0, -2.0}, {}};
-  Load ended{{{{30, 0}}}, {1.0, 1.0, 1.0}, {}};
+  Load first{{{{3, 4}, {20, 11}}}, {0.5, -0.25, 0.125}, false, {}};
+  Load second{{{{3, 4}}}, {1e-3, 7.0, -2.0}, false, {}};
+  Load ended{{{{30, 0}}}, {1.0, 1.0, 1.0}, false, {}};
   ended.window.end = 4;
   scene.loads = {first, second, ended};
   const Block block = Block::whole(scene.m, scene.n, MPI_COMM_SELF);
