@@ -86,6 +86,21 @@ Closest cylinder_closest(const Vec3& p, double radius, double half_length) {
   return {side, radial};
 }
 
+// cylinder_closest's distance alone, by the same operations, for the searches of
+// cylinder_deepest, which ask for nothing else: its normal's four divisions were half the cost
+// of a round table's rim cells.
+[[gnu::always_inline]] inline double cylinder_distance(const Vec3& p, double radius,
+                                                       double half_length) {
+  const double side = std::sqrt(p.x * p.x + p.y * p.y) - radius;
+  const double cap = std::abs(p.z) - half_length;
+  if (side > 0.0 || cap > 0.0) {
+    const double s = std::max(side, 0.0);
+    const double c = std::max(cap, 0.0);
+    return std::sqrt(s * s + c * c);
+  }
+  return cap >= side ? cap : side;
+}
+
 Closest capsule_closest(const Vec3& p, double radius, double half_length) {
   const Vec3 spine{0.0, 0.0, std::clamp(p.z, -half_length, half_length)};
   const Vec3 d = p - spine;
@@ -582,7 +597,7 @@ Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const
         candidates.push_back(closest_on_triangle({radius * cosine, radius * sine, z}, a, b, c));
   }
   const auto distance = [&](const Weights& w) {
-    return cylinder_closest(at(w, a, b, c), radius, half_length).distance;
+    return cylinder_distance(at(w, a, b, c), radius, half_length);
   };
   Weights best = candidates.front();
   double best_value = kInfinity;
