@@ -87,8 +87,8 @@ Closest cylinder_closest(const Vec3& p, double radius, double half_length) {
 }
 
 // cylinder_closest's distance alone, by the same operations, for the searches of
-// cylinder_deepest, which ask for nothing else: its normal's four divisions were half the cost
-// of a round table's rim cells.
+// cylinder_deepest, which ask for nothing else: its normal's four divisions were about half of
+// a round table's run.
 [[gnu::always_inline]] inline double cylinder_distance(const Vec3& p, double radius,
                                                        double half_length) {
   const double side = std::sqrt(p.x * p.x + p.y * p.y) - radius;
