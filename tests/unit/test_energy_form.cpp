@@ -54,6 +54,17 @@ double minus_difference(Sheet& sheet, int k, int l, int c, double step) {
   return -(up - down) / (2.0 * step);
 }
 
+// The forces with component c of node (k, l) moved by +step into `up` and by −step into `down`.
+void forces_either_side(Sheet& sheet, int k, int l, int c, double step, Field<Vec3>& up,
+                        Field<Vec3>& down) {
+  const double kept = sheet.r(k, l)[c];
+  sheet.r(k, l)[c] = kept + step;
+  sheet.energy.internal_force(sheet.r, up);
+  sheet.r(k, l)[c] = kept - step;
+  sheet.energy.internal_force(sheet.r, down);
+  sheet.r(k, l)[c] = kept;
+}
+
 // The force at (k, l) by its definition, f_q = −Σ_p ∂E_p/∂r_q, with every gradient from
 // node_energy at the nodes p of q's stencil that lie in the grid.
 Vec3 force_from_node_gradients(const CosseratEnergy& energy, const Field<Vec3>& r,
@@ -293,12 +304,7 @@ double collapsed_corner_stiffness(Quadrature q, double d) {
   for (int l = 0; l < s.n; ++l)
     for (int k = 0; k < s.m; ++k)
       for (int c = 0; c < 3; ++c) {
-        const double kept = sheet.r(k, l)[c];
-        sheet.r(k, l)[c] = kept + step;
-        sheet.energy.internal_force(sheet.r, up);
-        sheet.r(k, l)[c] = kept - step;
-        sheet.energy.internal_force(sheet.r, down);
-        sheet.r(k, l)[c] = kept;
+        forces_either_side(sheet, k, l, c, step, up, down);
         largest = std::max(largest, -(up(k, l)[c] - down(k, l)[c]) / (2.0 * step));
       }
   return largest;
@@ -328,12 +334,7 @@ TEST(EnergyForm, JacobianIsSymmetric) {
   double largest = 0.0;
   for (int column = 0; column < size; ++column) {
     const int node = column / 3, c = column % 3, k = node % m, l = node / m;
-    const double kept = sheet.r(k, l)[c];
-    sheet.r(k, l)[c] = kept + step;
-    sheet.energy.internal_force(sheet.r, up);
-    sheet.r(k, l)[c] = kept - step;
-    sheet.energy.internal_force(sheet.r, down);
-    sheet.r(k, l)[c] = kept;
+    forces_either_side(sheet, k, l, c, step, up, down);
     for (int row = 0; row < size; ++row) {
       const int rn = row / 3, rc = row % 3;
       const double d = (up(rn % m, rn / m)[rc] - down(rn % m, rn / m)[rc]) / (2.0 * step);
