@@ -46,6 +46,20 @@ bool EdgeCheck::vertical(int la, int ka, int kb, const Field<Vec3>& r,
   return flagged != 0;
 }
 
+// The edges (k, l)–(k + 1, l) within the owned columns.
+bool EdgeCheck::horizontal(int l, const Field<Vec3>& r, const Field<Vec3>& next) const {
+  const Block& b = *block_;
+  const Vec3 *p = &next(b.k0, l), *q = &r(b.k0, l);
+  const double limit2 = limit2_;
+  int flagged = 0;
+#pragma omp simd reduction(| : flagged)
+  for (int i = 0; i < b.owned_k() - 1; ++i)
+    flagged |= changed(p[i].x - q[i].x, p[i].y - q[i].y, p[i].z - q[i].z,
+                       p[i + 1].x - q[i + 1].x, p[i + 1].y - q[i + 1].y,
+                       p[i + 1].z - q[i + 1].z, limit2);
+  return flagged != 0;
+}
+
 void EdgeCheck::begin_walk() {
   walkers_.resize(static_cast<std::size_t>(omp_get_max_threads()));
   for (Walker& w : walkers_) w.last = INT_MIN;
@@ -92,8 +106,10 @@ void EdgeCheck::walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next) {
   walker.last = l;
 }
 
-const std::vector<char>& EdgeCheck::flag_rows(const Field<Vec3>& r, const Field<Vec3>& next) {
+const std::vector<char>& EdgeCheck::flag_rows(const Field<Vec3>& r, const Field<Vec3>& next,
+                                              const std::vector<char>* moved) {
   const Block& b = *block_;
+  const bool walked = walked_;
   if (!walked_) {
     begin_walk();
     // Static: each thread's rows are one ascending range, as in a scheme's walk.
@@ -117,6 +133,23 @@ const std::vector<char>& EdgeCheck::flag_rows(const Field<Vec3>& r, const Field<
       if ((b.k0 > 0 && edge(b.k0 - 1, l, b.k0, l, r, next)) ||
           (b.k1 < b.m && edge(b.k1 - 1, l, b.k1, l, r, next)))
         flag(l);
+    }
+  // What the walk tested before an action moved the row: the walk's flags stay, a superset of
+  // the rows to scan (a flag only costs the scan), and the moved rows' edges are tested anew.
+  if (walked && moved != nullptr)
+    for (int l = b.l0; l < b.l1; ++l) {
+      if (!(*moved)[static_cast<std::size_t>(l - b.l0)]) continue;
+      const auto row = static_cast<std::size_t>(l - b.l0);
+      if (horizontal(l, r, next)) flag(l);
+      // The edges to the row below, and to the row above unless that moved too and tests them.
+      if (l > b.l0 && vertical(l - 1, b.k0, b.k1, r, next)) {
+        flag(l - 1);
+        flag(l);
+      }
+      if (l + 1 < b.l1 && !(*moved)[row + 1] && vertical(l, b.k0, b.k1, r, next)) {
+        flag(l);
+        flag(l + 1);
+      }
     }
   // A lone node has no edge: only its own test can fail it.
   if (b.m == 1 && b.n == 1) flag(0);

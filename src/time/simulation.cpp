@@ -36,13 +36,19 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
 
 // CONTACT.md: the scene's solids against every proposed step, whatever the scheme; the run's
 // maxima kept over accepted steps.
-class Simulation::ContactAction final : public StepAction {
+class Simulation::ContactAction final : public StepAction, public RowReader {
  public:
   explicit ContactAction(Contact& contact) : contact_(&contact) {}
 
   void apply(ProposedStep& p) override {
     last_ = contact_->respond(p.time, p.dt, p.positions, p.next_positions, p.next_velocities,
-                              p.velocities);
+                              p.velocities, p.moved_rows);
+  }
+  RowReader* row_reader() override { return this; }
+  bool marks_moved_rows() const override { return true; }
+  void begin_walk() override { contact_->begin_walk(); }
+  void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next) override {
+    contact_->walk_row(l, r, next);
   }
   void accepted() override {
     contact_->accept();

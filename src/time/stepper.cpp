@@ -32,7 +32,7 @@ Stepper::Stepper(const Scene& scene, const Decomposition& decomposition, const B
       h2_(scene.h2()),
       max_move_(0.5 * std::min(scene.h1(), scene.h2())),
       edge_check_(block, max_move_) {
-  const StepContext context{block, halo, dynamics, constraints_, dt_, 0.0, 0.0, &edge_check_};
+  const StepContext context{block, halo, dynamics, constraints_, dt_, 0.0, 0.0, &rows_};
   scheme_ = make(SchemeSetup{scene, decomposition, context, positions});
   scheme_->begin(std::move(velocities));
 }
@@ -45,13 +45,25 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
   scheme_->set_step(dt, time_, end_time);
   dynamics_->set_time(time_);
   constraints_.begin_step(step_, time_, scheme_->positions());
-  edge_check_.arm(actions_.empty());
+  const bool marked = std::all_of(actions_.begin(), actions_.end(),
+                                  [](const auto& action) { return action->marks_moved_rows(); });
+  edge_check_.arm(marked);
+  rows_.clear();
+  if (marked) rows_.add(edge_check_);
+  for (const auto& action : actions_)
+    if (RowReader* reader = action->row_reader()) rows_.add(*reader);
   if (auto solver_failure = scheme_->advance(step_)) {
     return Instability{step_ + 1, end_time, -1, -1, false, std::move(solver_failure), {}};
   }
   set_velocities_.clear();
-  ProposedStep proposed{step_ + 1, dt, scheme_->positions(), scheme_->next_positions(),
-                        scheme_->next_velocities(), time_, set_velocities_};
+  const bool mark = marked && !actions_.empty();
+  if (mark)
+    moved_rows_.assign(static_cast<std::size_t>(block_->owned_l()), 0);
+  else
+    moved_rows_.clear();
+  ProposedStep proposed{step_ + 1,       dt,    scheme_->positions(), scheme_->next_positions(),
+                        scheme_->next_velocities(), time_, set_velocities_,
+                        mark ? &moved_rows_ : nullptr};
   for (const auto& action : actions_) action->apply(proposed);
   // The check compares each node's move with its neighbours', across block borders too; the
   // accepted positions are then where the next step's forces are read.
@@ -124,7 +136,8 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_ti
   // are still in cache), is scanned for its first failing node. Most steps flag none, and a
   // flagged row holds a failing node or neighbours one, so the scan is serial: threads started
   // for it would cost a step more than it does.
-  const std::vector<char>& may_fail = edge_check_.flag_rows(r, next);
+  const std::vector<char>& may_fail =
+      edge_check_.flag_rows(r, next, moved_rows_.empty() ? nullptr : &moved_rows_);
   long local = none;
   bool local_not_finite = false;
   for (int l = b.l0; l < b.l1 && local == none; ++l) {

@@ -64,14 +64,13 @@ void VerletFamily::centred_step(long step) {
   if (dynamics.fuses_rows()) {
     // Each row of a is used while the kernel still has it in cache, and never stored: the
     // step's largest sweep of memory saved (docs/kernel.md). The row is held, and the
-    // stability check's edge test reads it, while it is still there too.
+    // stability check's edge test and the contact's broad phase read it, while it is still
+    // there too.
     const double c = dynamics.row_velocity_terms().damping * weight / span;
     const Block& b = context_.block;
     const Constraints& constraints = context_.constraints;
-    EdgeCheck* edges = context_.edge_check != nullptr && context_.edge_check->armed()
-                           ? context_.edge_check
-                           : nullptr;
-    if (edges != nullptr) edges->begin_walk();
+    RowWalk* rows = context_.rows != nullptr && !context_.rows->empty() ? context_.rows : nullptr;
+    if (rows != nullptr) rows->begin_walk();
     dynamics.free_acceleration_rows(positions_, step, [&](int l, double* x, double* y, double* z) {
       const Vec3* r = &positions_(b.k0, l);
       const Vec3* rp = &previous_positions_(b.k0, l);
@@ -79,7 +78,7 @@ void VerletFamily::centred_step(long step) {
 #pragma omp simd
       for (int i = 0; i < b.owned_k(); ++i) next[i] = update(r[i], rp[i], {x[i], y[i], z[i]}, c);
       constraints.hold_row(next_positions_, l, context_.end_time);
-      if (edges != nullptr) edges->walk_row(l, positions_, next_positions_);
+      if (rows != nullptr) rows->walk_row(l, positions_, next_positions_);
     });
     return;
   }

@@ -97,6 +97,49 @@ TEST(EdgeCheck, FlagsExactlyTheRowsOfTheNodesWhoseEdgesChanged) {
   omp_set_num_threads(default_threads);
 }
 
+// A step action (a contact response) moves a node after the walk tested its rows, and marks
+// its row: the rows flagged are again exactly its own and its owned neighbours', on every
+// position of the grid and block and on 1, 2 and 3 threads. Left unmarked on one thread and the
+// whole grid (no edge left to test after the walk), the move is missed: why an action that does
+// not mark its rows keeps the walk from testing at all.
+TEST(EdgeCheck, TestsTheRowsAnActionMovedAfterTheWalkAgain) {
+  const int m = 9, n = 7;
+  Block whole = Block::whole(m, n, MPI_COMM_SELF);
+  Block inner = whole;
+  inner.k0 = 2, inner.k1 = 6, inner.l0 = 2, inner.l1 = 5;
+  const int default_threads = omp_get_max_threads();
+  const Vec3 move{0.0, 1.01 * kLimit, 0.0};
+  for (const Block* block : {&whole, &inner})
+    for (const int threads : {1, 2, 3}) {
+      const Block& b = *block;
+      omp_set_num_threads(threads);
+      EdgeCheck check(b, kLimit);
+      for (int l = b.l0; l < b.l1; ++l)
+        for (int k = b.k0; k < b.k1; ++k) {
+          States s(b, -1, -1, {});
+          std::set<int> expected;
+          for (const auto& [kk, ll] : {std::pair{k, l}, std::pair{k - 1, l}, std::pair{k + 1, l},
+                                       std::pair{k, l - 1}, std::pair{k, l + 1}})
+            if (b.owns(kk, ll)) expected.insert(ll);
+          std::vector<char> moved(static_cast<std::size_t>(b.owned_l()), 0);
+          for (const bool marked : {true, false}) {
+            if (!marked && (block != &whole || threads != 1)) continue;
+            check.arm(true);
+            walk(check, b, s);
+            s.next(k, l) = s.r(k, l) + move;
+            moved[static_cast<std::size_t>(l - b.l0)] = marked ? 1 : 0;
+            EXPECT_EQ(flagged(check.flag_rows(s.r, s.next, &moved), b),
+                      marked ? expected : std::set<int>{})
+                << "block [" << b.k0 << ", " << b.k1 << ") x [" << b.l0 << ", " << b.l1
+                << "), node (" << k << ", " << l << "), " << threads << " threads"
+                << (marked ? "" : ", unmarked");
+            s.next(k, l) = s.r(k, l);
+          }
+        }
+    }
+  omp_set_num_threads(default_threads);
+}
+
 // A move just inside the limit, relative to every neighbour, flags nothing; a rigid move of
 // any size neither.
 TEST(EdgeCheck, FlagsNoRowForMovesWithinTheLimitOrARigidMove) {

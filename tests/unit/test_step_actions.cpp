@@ -2,6 +2,7 @@
 // every scheme, on the proposed state, before the stability check accepts it.
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <vector>
@@ -82,6 +83,41 @@ TEST_P(EverySchemeWithAnAction, RunsBeforeTheStabilityCheck) {
   sim.stepper().add_action(std::make_unique<Kick>(scene.h1()));
   ASSERT_TRUE(testing::advance(sim, 2));
   const auto failure = sim.step();
+  ASSERT_TRUE(failure.has_value());
+  EXPECT_EQ(failure->step, 3);
+  EXPECT_EQ(failure->k, 2);
+  EXPECT_EQ(failure->l, 2);
+  EXPECT_EQ(sim.step_index(), 2);
+}
+
+// The same with an action that says which rows it moved, as the contact response does: the
+// stability check's edge test then runs in the Verlet step's row walk, before the action, and
+// tests the marked row again after it.
+TEST_P(EverySchemeWithAnAction, RunsBeforeTheStabilityCheckWhenItMarksItsRows) {
+  Scene scene = testing::flat_sheet(6, 5);
+  scene.integrator = GetParam();
+  class MarkedKick final : public StepAction {
+   public:
+    explicit MarkedKick(double distance) : distance_(distance) {}
+    void apply(ProposedStep& proposed) override {
+      ASSERT_NE(proposed.moved_rows, nullptr);
+      if (proposed.step != 3) return;
+      proposed.next_positions(2, 2).y += distance_;
+      (*proposed.moved_rows)[2] = 1;
+    }
+    bool marks_moved_rows() const override { return true; }
+
+   private:
+    double distance_;
+  };
+  // One thread: the walk then tests every edge of the block, none is left to the check.
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  Simulation sim(scene, MPI_COMM_SELF, any_scheme);
+  sim.stepper().add_action(std::make_unique<MarkedKick>(scene.h1()));
+  ASSERT_TRUE(testing::advance(sim, 2));
+  const auto failure = sim.step();
+  omp_set_num_threads(threads);
   ASSERT_TRUE(failure.has_value());
   EXPECT_EQ(failure->step, 3);
   EXPECT_EQ(failure->k, 2);

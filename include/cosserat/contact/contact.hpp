@@ -55,8 +55,16 @@ class Contact {
   // (next − current)/dt. Moves owned nodes of `next` out of every solid (its ghosts are left
   // stale: the caller exchanges them), lists the changed velocities in `corrected`, and
   // proposes the solids' state at time + dt. Collective over the block's ranks.
+  // With `moved_rows` (per owned row), sets the rows it moved a node of.
   ContactStats respond(double time, double dt, const Field<Vec3>& current, Field<Vec3>& next,
-                       const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected);
+                       const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected,
+                       std::vector<char>* moved_rows = nullptr);
+  // While a scheme's row walk still has them in cache: the broad phase's boxes from row l of
+  // the step's start and of its proposed end, from any thread, each row once. respond() then
+  // takes them rather than sweeping the nodes itself; a step without a walk leaves it to it.
+  void begin_walk() { walked_ = true; }
+  void walk_row(int l, const Field<Vec3>& current, const Field<Vec3>& next);
+
   // The proposed step was accepted: the solids take their proposed state.
   void accept();
 
@@ -99,6 +107,8 @@ class Contact {
   // Sets near_ and spare_ of tile t from its box.
   void classify(std::size_t t);
   void make_box(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
+  // The same from the rows walk_row() saw.
+  void merge_rows(int i, int j);
   [[gnu::always_inline]] inline void grow_box(std::size_t t, int k, int l,
                                               const Field<Vec3>& current,
                                               const Field<Vec3>& next);
@@ -152,6 +162,9 @@ class Contact {
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
   int tiles_k_ = 0, tiles_l_ = 0;
   std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
+  // Per owned row and tile column, from walk_row(): as boxes_, `moved` the largest squared move.
+  std::vector<Box> row_boxes_;
+  bool walked_ = false;                      // walk_row() saw every row of this step
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes

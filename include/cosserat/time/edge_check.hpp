@@ -7,16 +7,18 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/vec3.hpp"
+#include "cosserat/time/row_walk.hpp"
 
 namespace cosserat {
 
-class EdgeCheck {
+class EdgeCheck final : public RowReader {
  public:
   // limit: the largest change of an edge that passes (half the smaller grid spacing).
   EdgeCheck(const Block& block, double limit);
 
   // Whether a scheme may test rows during its walk in this step: not when a step action (a
-  // contact response) moves nodes after the scheme and before the check.
+  // contact response) moves nodes after the scheme and before the check without saying which
+  // rows it moved.
   bool armed() const { return armed_; }
   void arm(bool on) {
     armed_ = on;
@@ -26,18 +28,21 @@ class EdgeCheck {
   // A walk, in which each thread hands over the rows of r and r⁺ it has just finished, in
   // ascending order, held by the constraints. Tests the edges within the row's owned columns
   // and, if the same thread handed over the row below, the edges between the two.
-  void begin_walk();
-  void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next);
+  void begin_walk() override;
+  void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next) override;
 
   // After the exchange of r⁺'s ghosts: per owned row, whether some edge of one of its nodes
   // may have changed too much (a NaN or infinity changes every edge of its node). What the walk
   // left untested (edges between threads' bands, to ghost rows and columns) is tested now; with
-  // no walk in this step, everything is.
-  const std::vector<char>& flag_rows(const Field<Vec3>& r, const Field<Vec3>& next);
+  // no walk in this step, everything is. `moved`, per owned row, the rows a step action moved
+  // nodes of after the walk: their edges, and those to the rows either side, are tested again.
+  const std::vector<char>& flag_rows(const Field<Vec3>& r, const Field<Vec3>& next,
+                                     const std::vector<char>* moved = nullptr);
 
  private:
   bool edge(int ka, int la, int kb, int lb, const Field<Vec3>& r, const Field<Vec3>& next) const;
   bool vertical(int la, int ka, int kb, const Field<Vec3>& r, const Field<Vec3>& next) const;
+  bool horizontal(int l, const Field<Vec3>& r, const Field<Vec3>& next) const;
 
   const Block* block_;
   double limit2_;

@@ -19,6 +19,7 @@
 #include "cosserat/time/dynamics.hpp"
 #include "cosserat/time/edge_check.hpp"
 #include "cosserat/time/linear_solve_stats.hpp"
+#include "cosserat/time/row_walk.hpp"
 
 namespace cosserat {
 
@@ -43,9 +44,9 @@ struct StepContext {
   double dt;
   double time = 0.0;      // at the start of the step
   double end_time = 0.0;  // at its end, as the Stepper counts it (held positions move with it)
-  // The stability check's edge test, for a scheme that finishes r⁺ row by row to run while
-  // the rows are in cache; null where no check follows.
-  EdgeCheck* edge_check = nullptr;
+  // What reads r⁺ row by row while a scheme that finishes it so has the rows in cache (the
+  // stability check's edge test, a contact's broad phase); null or empty where none does.
+  RowWalk* rows = nullptr;
 };
 
 class Scheme {

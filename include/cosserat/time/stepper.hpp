@@ -13,6 +13,7 @@
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
 #include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/row_walk.hpp"
 #include "cosserat/time/scheme.hpp"
 
 namespace cosserat {
@@ -41,6 +42,9 @@ struct ProposedStep {
   // emptied for each step: a contact scene sets up to every node's, and allocating them every
   // step cost more than the response itself.
   std::vector<NodeVelocity>& velocities;
+  // Per owned row, 0 on entry: an action that marks_moved_rows() sets the rows it moved nodes
+  // of, so that the stability check tests only those again. Null when no check needs them.
+  std::vector<char>* moved_rows = nullptr;
 };
 
 // Something done on every step whatever the scheme (a contact response, a step-size choice):
@@ -56,6 +60,11 @@ class StepAction {
   // roll-back snapshots and checkpoints; restore() takes what state() gave.
   virtual std::vector<double> state() const { return {}; }
   virtual void restore(const std::vector<double>& /*values*/) {}
+  // What reads the scheme's rows as its walk finishes them (RowReader), or null.
+  virtual RowReader* row_reader() { return nullptr; }
+  // Whether apply() marks every row it moved a node of in ProposedStep::moved_rows. Only when
+  // every action does may the stability check's edge test run in the walk, before them.
+  virtual bool marks_moved_rows() const { return false; }
 };
 
 class Stepper {
@@ -127,6 +136,8 @@ class Stepper {
   double h1_, h2_;
   double max_move_;  // half the smaller grid spacing (MODEL.md §4.2)
   EdgeCheck edge_check_;
+  RowWalk rows_;                 // this step's readers of the scheme's row walk
+  std::vector<char> moved_rows_;  // ProposedStep::moved_rows
   long step_ = 0;
   double time_ = 0.0;
   std::unique_ptr<Scheme> scheme_;
