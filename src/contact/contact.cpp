@@ -700,6 +700,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   };
   const double radius = g.bounding_radius();
   const bool convex = s.spec.shape.kind != ShapeKind::mesh;
+  const double bound_slack = kBroadSlack * (radius + thickness);
   halo_->exchange(next);
   halo_->exchange(velocity_);
   // The broad phase: a tile's cells are visited only when the box of their nodes (the tile's
@@ -830,6 +831,9 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
               }
               if (lower >= flat_offset) continue;
             }
+            // The deepest point's distance is at least the bound, and the offset below at
+            // most flat_offset (rounded: the slack).
+            if (g.lower_bound(p[0], p[1], p[2]) >= flat_offset + bound_slack) continue;
             const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
             if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
             const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];

@@ -782,6 +782,54 @@ std::array<double, 3> SolidGeometry::deepest_point(const Vec3& a, const Vec3& b,
   throw std::logic_error("SolidGeometry::deepest_point: unknown shape kind");
 }
 
+namespace {
+// The smallest |x| over the values a linear function takes at a triangle's corners.
+double smallest_magnitude(double a, double b, double c) {
+  if ((a > 0.0 && b > 0.0 && c > 0.0) || (a < 0.0 && b < 0.0 && c < 0.0))
+    return std::min({std::abs(a), std::abs(b), std::abs(c)});
+  return 0.0;
+}
+
+// The distance from the z axis to triangle (a, b, c): from the origin to its projection on
+// the xy plane, zero when that holds the origin, else along its nearest edge.
+double axis_distance(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const std::array<std::array<double, 2>, 3> p{{{a.x, a.y}, {b.x, b.y}, {c.x, c.y}}};
+  const auto side = [&](int i, int j) { return p[i][0] * p[j][1] - p[i][1] * p[j][0]; };
+  const double s0 = side(0, 1), s1 = side(1, 2), s2 = side(2, 0);
+  if ((s0 >= 0.0 && s1 >= 0.0 && s2 >= 0.0) || (s0 <= 0.0 && s1 <= 0.0 && s2 <= 0.0)) return 0.0;
+  double nearest2 = kInfinity;
+  for (int i = 0; i < 3; ++i) {
+    const auto& u = p[static_cast<std::size_t>(i)];
+    const auto& v = p[static_cast<std::size_t>((i + 1) % 3)];
+    const double ex = v[0] - u[0], ey = v[1] - u[1];
+    const double length2 = ex * ex + ey * ey;
+    const double t =
+        length2 > 0.0 ? std::clamp(-(u[0] * ex + u[1] * ey) / length2, 0.0, 1.0) : 0.0;
+    const double x = u[0] + t * ex, y = u[1] + t * ey;
+    nearest2 = std::min(nearest2, x * x + y * y);
+  }
+  return std::sqrt(nearest2);
+}
+}  // namespace
+
+// The solid lies inside each slab |x_i| <= h_i (and a cylinder inside ρ <= R), so its signed
+// distance is at least each of |x_i| − h_i (ρ − R), inside it as well as outside.
+double SolidGeometry::lower_bound(const Vec3& a, const Vec3& b, const Vec3& c) const {
+  switch (shape_.kind) {
+    case ShapeKind::box: {
+      const Vec3& h = shape_.half_extents;
+      return std::max({smallest_magnitude(a.x, b.x, c.x) - h.x,
+                       smallest_magnitude(a.y, b.y, c.y) - h.y,
+                       smallest_magnitude(a.z, b.z, c.z) - h.z});
+    }
+    case ShapeKind::cylinder:
+      return std::max(axis_distance(a, b, c) - shape_.radius,
+                      smallest_magnitude(a.z, b.z, c.z) - shape_.half_length);
+    default:
+      return -kInfinity;
+  }
+}
+
 Vec3 SolidGeometry::inertia_per_mass() const {
   const double r2 = shape_.radius * shape_.radius;
   const double h = shape_.half_length;

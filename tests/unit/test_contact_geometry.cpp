@@ -641,6 +641,41 @@ TEST(GeometryTest, DeepestPointBeatsAFineLattice) {
   }
 }
 
+// The triangle's lower bound of the distance never exceeds the distance anywhere on it (a fine
+// lattice, its corners included), for triangles small and large, inside, across and outside
+// the box and the cylinder; and it is the distance itself for a triangle above a face, where
+// it lets the cell pass skip the deepest-point search: the lowest corner's height over the
+// face.
+TEST(GeometryTest, TheTrianglesLowerBoundHoldsEverywhereOnIt) {
+  std::mt19937_64 rng(12);
+  for (const Shape& shape : {box({1.0, 0.5, 0.3}), cylinder(0.4, 0.6)}) {
+    const SolidGeometry geometry(shape);
+    SCOPED_TRACE(static_cast<int>(shape.kind));
+    for (int i = 0; i < 400; ++i) {
+      const Vec3 centre = random_vector(rng, 1.0);
+      const double size = i % 2 == 0 ? 0.05 : 1.0;
+      const Vec3 a = centre + random_vector(rng, size);
+      const Vec3 b = centre + random_vector(rng, size);
+      const Vec3 c = centre + random_vector(rng, size);
+      const double bound = geometry.lower_bound(a, b, c);
+      constexpr int kDivisions = 60;
+      double lattice = std::numeric_limits<double>::infinity();
+      for (int j = 0; j <= kDivisions; ++j)
+        for (int k = 0; j + k <= kDivisions; ++k) {
+          const std::array<double, 3> s{1.0 - double(j + k) / kDivisions, double(j) / kDivisions,
+                                        double(k) / kDivisions};
+          lattice = std::min(lattice, geometry.closest(at(s, a, b, c)).distance);
+        }
+      EXPECT_LE(bound, lattice + 1e-12) << "triangle " << i;
+    }
+    // A small triangle over the top face, its corners 2, 3 and 5 mm above it.
+    const double top = shape.kind == ShapeKind::box ? 0.3 : 0.6;
+    EXPECT_NEAR(geometry.lower_bound({0.0, 0.0, top + 0.003}, {0.03, 0.0, top + 0.002},
+                                     {0.0, 0.03, top + 0.005}),
+                0.002, 1e-15);
+  }
+}
+
 // ---- Mass properties --------------------------------------------------------------------
 
 TEST(GeometryTest, InertiaMatchesClosedFormsAndMonteCarlo) {
