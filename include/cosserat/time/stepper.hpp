@@ -138,6 +138,7 @@ class Stepper {
   EdgeCheck edge_check_;
   RowWalk rows_;                 // this step's readers of the scheme's row walk
   std::vector<char> moved_rows_;  // ProposedStep::moved_rows
+  bool moved_most_ = false;       // the last step's actions moved most rows
   long step_ = 0;
   double time_ = 0.0;
   std::unique_ptr<Scheme> scheme_;
