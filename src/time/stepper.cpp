@@ -49,8 +49,7 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
                                   [](const auto& action) { return action->marks_moved_rows(); });
   // The edge test in the walk pays where the actions move few rows; where they moved most of
   // the last step's (cloth lying on a floor), testing those again cost more than one pass
-  // after them (benchmarks/results/contact-walk-vm-2026-12-03.md). Either way the same rows
-  // are found.
+  // after them (docs/contact.md, "Cost"). Either way the same rows are found.
   edge_check_.arm(marked && !moved_most_);
   rows_.clear();
   if (edge_check_.armed()) rows_.add(edge_check_);
