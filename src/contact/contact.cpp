@@ -244,7 +244,8 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
       surface_velocity_(block),
       normal_speed_(block),
       distance_(block),
-      normal_(block) {
+      normal_(block),
+      local_(block) {
   if (!solids.empty()) {
     tiles_k_ = (block.owned_k() + kTile - 1) / kTile;
     tiles_l_ = (block.owned_l() + kTile - 1) / kTile;
@@ -672,6 +673,32 @@ constexpr std::array<Around, 12> triangles_around() {
   return around;
 }
 constexpr std::array<Around, 12> kAround = triangles_around();
+
+// The six edges of a cell, by their corners as offsets from (kc, lc): the four sides and the
+// two diagonals; and each triangle's three edges among them, derived from triangle_corners.
+constexpr std::array<std::array<std::array<int, 2>, 2>, 6> kCellEdges{{
+    {{{0, 0}, {1, 0}}}, {{{1, 0}, {1, 1}}}, {{{0, 0}, {1, 1}}},
+    {{{0, 0}, {0, 1}}}, {{{0, 1}, {1, 1}}}, {{{1, 0}, {0, 1}}}}};
+constexpr std::array<std::array<int, 3>, kCellTriangles> triangle_edges() {
+  std::array<std::array<int, 3>, kCellTriangles> edges{};
+  for (int tri = 0; tri < kCellTriangles; ++tri) {
+    const TriangleCorners c = triangle_corners(0, 0, tri);
+    for (int v = 0; v < 3; ++v) {
+      const auto& a = c[static_cast<std::size_t>(v)];
+      const auto& b = c[static_cast<std::size_t>((v + 1) % 3)];
+      int found = -1;
+      for (int e = 0; e < 6; ++e) {
+        const auto& edge = kCellEdges[static_cast<std::size_t>(e)];
+        if ((edge[0] == a && edge[1] == b) || (edge[0] == b && edge[1] == a)) found = e;
+      }
+      // Reached at compile time only if a triangle had an edge that is not the cell's.
+      if (found < 0) throw "a triangle's edge must be one of its cell's six";
+      edges[static_cast<std::size_t>(tri)][static_cast<std::size_t>(v)] = found;
+    }
+  }
+  return edges;
+}
+constexpr std::array<std::array<int, 3>, kCellTriangles> kTriangleEdges = triangle_edges();
 }  // namespace
 
 // Between nodes (docs/contact.md, "Cells"): each triangle of a cell (triangle_corners) at its
@@ -764,11 +791,12 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       for (int l = la; l <= lb; ++l)
         for (int k = ka; k <= kb; ++k) {
           const double outside_ball = norm(next(k, l) - centre) - radius;
+          local_(k, l) = s.proposed.pose.to_local(next(k, l));
           if (outside_ball > thickness) {
             distance_(k, l) = outside_ball;
             normal_(k, l) = {};
           } else {
-            const Closest near = g.closest(s.proposed.pose.to_local(next(k, l)));
+            const Closest near = g.closest(local_(k, l));
             distance_(k, l) = near.distance;
             normal_(k, l) = near.normal;
           }
@@ -793,29 +821,30 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         for (int kc = cells.k0; kc < cells.k1; ++kc) {
           // The test below for every triangle of the cell at once: its nodes' nearest and its
           // six edges' longest bound each triangle's, and the difference is monotone in both,
-          // rounded too.
-          const Vec3 &p00 = next(kc, lc), &p10 = next(kc + 1, lc);
-          const Vec3 &p01 = next(kc, lc + 1), &p11 = next(kc + 1, lc + 1);
+          // rounded too. An edge's length is the same whichever way it is walked.
+          std::array<double, 6> edge{};
+          for (std::size_t e = 0; e < edge.size(); ++e) {
+            const auto& [a, b2] = kCellEdges[e];
+            edge[e] = norm(next(kc + b2[0], lc + b2[1]) - next(kc + a[0], lc + a[1]));
+          }
           const double cell_nearest =
               std::min(std::min(distance_(kc, lc), distance_(kc + 1, lc)),
                        std::min(distance_(kc, lc + 1), distance_(kc + 1, lc + 1)));
-          const double cell_longest =
-              std::max({norm(p10 - p00), norm(p11 - p10), norm(p11 - p00), norm(p01 - p00),
-                        norm(p11 - p01), norm(p01 - p10)});
+          const double cell_longest = *std::max_element(edge.begin(), edge.end());
           if (cell_nearest - cell_longest >= flat_offset) continue;
           for (int tri = 0; tri < kCellTriangles; ++tri) {
             const TriangleCorners nodes = triangle_corners(kc, lc, tri);
             double nearest = 1e300, longest = 0.0;
             for (int v = 0; v < 3; ++v) {
               nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
-              const auto& a = nodes[v];
-              const auto& b2 = nodes[(v + 1) % 3];
-              longest = std::max(longest, norm(next(b2[0], b2[1]) - next(a[0], a[1])));
+              longest = std::max(longest, edge[static_cast<std::size_t>(
+                                              kTriangleEdges[static_cast<std::size_t>(tri)]
+                                                            [static_cast<std::size_t>(v)])]);
             }
             if (nearest - longest >= flat_offset) continue;
             std::array<Vec3, 3> p;
             for (int v = 0; v < 3; ++v)
-              p[v] = s.proposed.pose.to_local(next(nodes[v][0], nodes[v][1]));
+              p[v] = local_(nodes[v][0], nodes[v][1]);
             // The signed distance to a convex solid lies above its tangent plane at each node,
             // so over the triangle it is at least d_v + min_j n_v·(p_j − p_v) for every node v:
             // a cell resting on a face, all its nodes on the offset surface, is not tested

@@ -158,6 +158,7 @@ class Contact {
   Field<double> normal_speed_;     // and the response's normal speed away from it
   Field<double> distance_;         // cell_pass: a lower bound of each node's signed distance
   Field<Vec3> normal_;             // and the normal there (solid's frame), zero when far
+  Field<Vec3> local_;              // cell_pass: each node's proposed end in the solid's frame
   std::vector<CellPush> cells_;    // cell_pass: the triangles pressed in
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
   int tiles_k_ = 0, tiles_l_ = 0;
