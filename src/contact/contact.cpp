@@ -260,7 +260,21 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     ready_.resize(tiles);
     exchange_rows_.resize(static_cast<std::size_t>(tiles_l_));
     push_rows_.resize(static_cast<std::size_t>(tiles_l_));
+    const auto rows = static_cast<std::size_t>(block.owned_l());
+    walk_touched_.resize(rows);
+    walk_settled_.resize(rows);
+    walk_inside_.resize(rows);
+    walk_deepest_.resize(rows);
   }
+  for (const bool plane : {true, false})
+    for (std::size_t i = 0; i < solids.size(); ++i)
+      if ((solids[i].shape.kind == ShapeKind::plane) == plane) {
+        order_.push_back(i);
+        if (plane) {
+          ++planes_;
+          plane_bits_ |= solid_bit(i);
+        }
+      }
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false, {}, {}, {}, {}, {}};
     if (spec.motion == SolidMotion::free) {
@@ -351,6 +365,19 @@ Vec3 Contact::settled_velocity(int k, int l, const Field<Vec3>& current,
 // tangential a Δt² of every step.
 Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal) const {
   return dt_ * (change - dot(change, normal) * normal);
+}
+
+bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface) const {
+  const Vec3& n = s.plane_normal;
+  const double offset = s.spec.thickness;
+  const double d = dot(r - s.proposed.pose.position, n);
+  if (d >= offset) return false;
+  const Vec3 point = r + (offset - d) * n;
+  surface = surface_velocity(s.proposed, point);
+  const Vec3 change = velocity_change(s, surface, n, v);
+  r = point + slip_correction(change, n);
+  v = v + change;
+  return true;
 }
 
 void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
@@ -454,10 +481,64 @@ void Contact::make_box(int i, int j, const Field<Vec3>& current, const Field<Vec
 // threads, so each row has its own. Vec3 is three packed doubles, so a full tile's nodes are
 // 24 interleaved doubles: their elementwise extremes and squared moves vectorise, and only the
 // folds onto x, y and z are scalar (a node-by-node loop cost 2.5 ns a node at 1024²).
-void Contact::walk_row(int l, const Field<Vec3>& current, const Field<Vec3>& next) {
+void Contact::begin_walk(double time, double dt) {
+  propose(time, dt);
+  proposed_ = walked_ = true;
+  dt_ = dt;
+  next_velocities_ = nullptr;
+}
+
+// The planes first (order_), each node's as node_pass meets them, while the row is in cache;
+// the velocity it leaves with, as settled_velocity() gives it, kept for when nothing after
+// moves it again, and its proposed end for prepare() when something may. Then the boxes, of
+// the moved row.
+void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double));
   constexpr int kValues = 3 * kTile;
   const Block& b = *block_;
+  if (planes_ > 0) {
+    const auto row = static_cast<std::size_t>(l - b.l0);
+    std::vector<WalkTouch>& touched = walk_touched_[row];
+    std::vector<NodeVelocity>& settled = walk_settled_[row];
+    touched.clear();
+    settled.clear();
+    char inside = 0;
+    double deepest = 0.0;
+    for (int k = b.k0; k < b.k1; ++k) {
+      Vec3& r = next(k, l);
+      const Vec3 proposed = r;
+      const Vec3 start = current(k, l);
+      Vec3 v = (proposed - start) / dt_;
+      Vec3 normal, surface;
+      double speed = 0.0;
+      bool met = false;
+      for (std::size_t o = 0; o < planes_; ++o) {
+        const Solid& s = solids_[order_[o]];
+        const Vec3 v_before = v;
+        Vec3 at;
+        if (!meet_plane(s, r, v, at)) continue;
+        met = true;
+        normal = s.plane_normal;
+        surface = at;
+        const double approach = dot(v_before - at, normal);
+        speed = approach < 0.0 ? -s.spec.restitution * approach : approach;
+      }
+      if (!met) continue;
+      touched.push_back({k, proposed});
+      const Vec3 moved = (r - start) / dt_;
+      settled.push_back({k, l, moved + (speed - dot(moved - surface, normal)) * normal});
+      // any_inside()'s test of the planes, for the nodes they moved: the others are clear.
+      for (std::size_t o = 0; o < planes_; ++o) {
+        const Solid& s = solids_[order_[o]];
+        const double offset = s.spec.thickness;
+        const double d = dot(r - s.proposed.pose.position, s.plane_normal);
+        deepest = std::max(deepest, -d);
+        if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
+      }
+    }
+    walk_inside_[row] = inside;
+    walk_deepest_[row] = deepest;
+  }
   Box* boxes = &row_boxes_[static_cast<std::size_t>(l - b.l0) * static_cast<std::size_t>(tiles_k_)];
   const double* start = &current(b.k0, l).x;
   const double* end = &next(b.k0, l).x;
@@ -524,8 +605,10 @@ void Contact::grow_box(std::size_t t, int k, int l, const Field<Vec3>& current,
   tile_touched_[t] = 1;
 }
 
-// A tile's velocities before the response moves any of its nodes.
-void Contact::prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next) {
+// A tile's velocities before the response moves any of its nodes. After a walk, the nodes it
+// moved onto planes are met by them again from their proposed ends, now into the fields the
+// response keeps: the same arithmetic on the same numbers, so the same bits.
+void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& next) {
   const std::size_t t = tile(i, j);
   if (ready_[t]) return;
   const TileRange r = tile_nodes(i, j);
@@ -535,6 +618,23 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3
                                          : (next(k, l) - current(k, l)) / dt_;
       touched_(k, l) = 0;
     }
+  if (walked_)
+    for (int l = r.l0; l < r.l1; ++l)
+      for (const WalkTouch& w : walk_touched_[static_cast<std::size_t>(l - block_->l0)]) {
+        if (w.k < r.k0) continue;
+        if (w.k >= r.k1) break;
+        Vec3& position = next(w.k, l);
+        position = w.proposed;
+        Vec3 v = (position - current(w.k, l)) / dt_;
+        for (std::size_t o = 0; o < planes_; ++o) {
+          const Solid& s = solids_[order_[o]];
+          const Vec3 v_before = v;
+          Vec3 surface;
+          if (meet_plane(s, position, v, surface))
+            remember(s, w.k, l, s.plane_normal, surface, v_before);
+        }
+        velocity_(w.k, l) = v;
+      }
   ready_[t] = 1;
 }
 
@@ -542,16 +642,18 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3
 // each end in the solid's frame at its own time, against the solid inflated by `thickness`.
 // An end inside goes to the nearest point of the inflated surface; an end beyond a thin solid
 // the segment passed through goes back onto the tangent plane where the segment entered.
-// Solids in scene order, each seeing the node where the ones before it put it.
+// The planes and then the other solids, each in scene order (order_), each seeing the node
+// where the ones before it put it. After a walk, the first pass's planes are done.
 void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                         std::vector<Exchange>& out) {
+  const std::size_t first = walked_ && pass == 0 ? planes_ : 0;
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j) {
     std::vector<Exchange>& row = exchange_rows_[static_cast<std::size_t>(j)];
     row.clear();
     for (int ti = 0; ti < tiles_k_; ++ti) {
       const std::size_t here = tile(ti, j);
-      const std::uint64_t near = near_[here];
+      const std::uint64_t near = near_[here] & (first > 0 ? ~plane_bits_ : ~std::uint64_t{0});
       if (near == 0) continue;
       prepare(ti, j, current, next);
       const TileRange range = tile_nodes(ti, j);
@@ -563,57 +665,61 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
           // farther than the tile's spare can meet any of the later ones.
           const Vec3 proposed = next(k, l);
           bool moved = false;
-          for (std::size_t i = 0; i < solids_.size(); ++i) {
+          for (std::size_t o = first; o < order_.size(); ++o) {
+            const std::size_t i = order_[o];
             if (!(near & solid_bit(i)) && !(moved && !(norm(next(k, l) - proposed) < spare)))
               continue;
             const Solid& s = solids_[i];
             const SolidGeometry& g = s.geometry;
             const double offset = s.spec.thickness;
-            const Vec3 world_end = next(k, l);
-            const Vec3 world_start = current(k, l);
-            Vec3 point, n;
             if (s.spec.shape.kind == ShapeKind::plane) {
               // A plane, in the world frame: only an end closer than the offset meets it.
-              n = s.plane_normal;
-              const double d = dot(world_end - s.proposed.pose.position, n);
-              if (d >= offset) continue;
-              point = world_end + (offset - d) * n;
-            } else {
-              // A segment that stays outside the ball holding the solid cannot touch it: first
-              // in world coordinates, then in the solid's frame. The path in the frame is at
-              // most the node's own, plus the frame's shift, plus its turn times the node's
-              // distance from the frame's origin (a chord is shorter than its arc).
-              const double path_bound = norm(world_end - world_start) + shift_[i] +
-                                        turn_[i] * norm(world_start - s.state.pose.position);
-              if (norm(world_end - s.proposed.pose.position) - path_bound >
-                  g.bounding_radius() + offset)
-                continue;
-              const Vec3 end = s.proposed.pose.to_local(world_end);
-              const Vec3 start = s.state.pose.to_local(world_start);
-              const Vec3 path = end - start;
-              if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
-              const Closest at_end = g.closest(end);
-              Vec3 target, normal;
-              if (at_end.distance < offset) {
-                normal = at_end.normal;
-                target = end + (offset - at_end.distance) * normal;
-              } else {
-                // Both ends outside: only a segment crossing the solid can touch it.
-                if (g.closest(start).distance < offset) continue;  // leaving, not entering
-                const std::optional<double> t = g.first_contact(start, end, offset);
-                if (!t) continue;
-                const Vec3 entry = start + *t * path;
-                normal = g.closest(entry).normal;
-                // A node leaving the offset surface it rested on meets it at t = 0 when
-                // round-off puts its start a hair outside: it is not entering. Put back on the
-                // tangent plane, it stayed glued to a box's side face while its velocity grew
-                // without bound.
-                if (dot(path, normal) >= 0.0) continue;
-                target = end - dot(end - entry, normal) * normal;
-              }
-              point = s.proposed.pose.to_world(target);
-              n = s.proposed.pose.direction_to_world(normal);
+              Vec3& r = next(k, l);
+              const Vec3 v_before = velocity_(k, l);
+              Vec3 v = v_before, surface;
+              if (!meet_plane(s, r, v, surface)) continue;
+              velocity_(k, l) = v;
+              remember(s, k, l, s.plane_normal, surface, v_before);
+              moved = grew = true;
+              grow_box(here, k, l, current, next);
+              continue;
             }
+            const Vec3 world_end = next(k, l);
+            const Vec3 world_start = current(k, l);
+            // A segment that stays outside the ball holding the solid cannot touch it: first
+            // in world coordinates, then in the solid's frame. The path in the frame is at
+            // most the node's own, plus the frame's shift, plus its turn times the node's
+            // distance from the frame's origin (a chord is shorter than its arc).
+            const double path_bound = norm(world_end - world_start) + shift_[i] +
+                                      turn_[i] * norm(world_start - s.state.pose.position);
+            if (norm(world_end - s.proposed.pose.position) - path_bound >
+                g.bounding_radius() + offset)
+              continue;
+            const Vec3 end = s.proposed.pose.to_local(world_end);
+            const Vec3 start = s.state.pose.to_local(world_start);
+            const Vec3 path = end - start;
+            if (norm(end) - norm(path) > g.bounding_radius() + offset) continue;
+            const Closest at_end = g.closest(end);
+            Vec3 target, normal;
+            if (at_end.distance < offset) {
+              normal = at_end.normal;
+              target = end + (offset - at_end.distance) * normal;
+            } else {
+              // Both ends outside: only a segment crossing the solid can touch it.
+              if (g.closest(start).distance < offset) continue;  // leaving, not entering
+              const std::optional<double> t = g.first_contact(start, end, offset);
+              if (!t) continue;
+              const Vec3 entry = start + *t * path;
+              normal = g.closest(entry).normal;
+              // A node leaving the offset surface it rested on meets it at t = 0 when
+              // round-off puts its start a hair outside: it is not entering. Put back on the
+              // tangent plane, it stayed glued to a box's side face while its velocity grew
+              // without bound.
+              if (dot(path, normal) >= 0.0) continue;
+              target = end - dot(end - entry, normal) * normal;
+            }
+            const Vec3 point = s.proposed.pose.to_world(target);
+            const Vec3 n = s.proposed.pose.direction_to_world(normal);
             Vec3& r = next(k, l);
             const Vec3 r_before = r;
             const Vec3 v_before = velocity_(k, l);
@@ -961,13 +1067,23 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   for (const auto& row : exchange_rows_) out.insert(out.end(), row.begin(), row.end());
 }
 
-bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {
+bool Contact::any_inside(int pass, const Field<Vec3>& next, double& penetration) const {
   int inside = 0;
   double deepest = 0.0;
+  // After a walk, the first pass's planes were tested there, on the nodes they moved; here only
+  // where a bounded solid moved a node since.
+  const bool walk_tested = walked_ && pass == 0;
+  if (walk_tested)
+    for (std::size_t row = 0; row < walk_inside_.size(); ++row) {
+      inside = std::max(inside, static_cast<int>(walk_inside_[row]));
+      deepest = std::max(deepest, walk_deepest_[row]);
+    }
 #pragma omp parallel for schedule(static) reduction(max : inside, deepest)
   for (int j = 0; j < tiles_l_; ++j)
     for (int ti = 0; ti < tiles_k_; ++ti) {
-      const std::uint64_t near = near_[tile(ti, j)];
+      const std::size_t t = tile(ti, j);
+      const std::uint64_t near =
+          near_[t] & (walk_tested && !tile_touched_[t] ? ~plane_bits_ : ~std::uint64_t{0});
       if (near == 0) continue;
       const TileRange range = tile_nodes(ti, j);
       for (int l = range.l0; l < range.l1; ++l)
@@ -996,12 +1112,7 @@ bool Contact::any_inside(const Field<Vec3>& next, double& penetration) const {
   return any != 0;
 }
 
-ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current,
-                              Field<Vec3>& next, const Field<Vec3>* next_velocities,
-                              std::vector<NodeVelocity>& corrected,
-                              std::vector<char>* moved_rows) {
-  const Block& b = *block_;
-  dt_ = dt;
+void Contact::propose(double time, double dt) {
   shift_.assign(solids_.size(), 0.0);
   turn_.assign(solids_.size(), 0.0);
   for (std::size_t i = 0; i < solids_.size(); ++i) {
@@ -1030,23 +1141,33 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
       s.reach_hi = centre + extent;
     }
   }
+}
+
+ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current,
+                              Field<Vec3>& next, const Field<Vec3>* next_velocities,
+                              std::vector<NodeVelocity>& corrected,
+                              std::vector<char>* moved_rows) {
+  const Block& b = *block_;
+  if (!proposed_) propose(time, dt);
+  proposed_ = false;
+  dt_ = dt;
   // Each tile's box, from the scheme's row walk or a sweep of its own; the velocities only
   // where the response can need them (prepare): on tiles a solid can reach, and on the tiles
   // along a border with another block, which the cell pass's exchange sends to its ghosts.
+  // After a walk, the planes of the first pass are met, and need nothing here.
   next_velocities_ = next_velocities;
-  const bool walked = walked_;
-  walked_ = false;
+  const std::uint64_t first_pass = walked_ ? ~plane_bits_ : ~std::uint64_t{0};
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
       const std::size_t t = tile(i, j);
       tile_touched_[t] = 0;
       ready_[t] = 0;
-      if (walked)
+      if (walked_)
         merge_rows(i, j);
       else
         make_box(i, j, current, next);
-      if (near_[t] || (i == 0 && b.k0 > 0) || (j == 0 && b.l0 > 0) ||
+      if ((near_[t] & first_pass) || (i == 0 && b.k0 > 0) || (j == 0 && b.l0 > 0) ||
           (i == tiles_k_ - 1 && b.k1 < b.m) || (j == tiles_l_ - 1 && b.l1 < b.n))
         prepare(i, j, current, next);
     }
@@ -1056,9 +1177,10 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   for (int pass = 0; pass < kMaxPasses; ++pass) {
     node_pass(pass, current, next, exchanges);
     for (std::size_t i = 0; i < solids_.size(); ++i)
-      if (std::isfinite(solids_[i].geometry.bounding_radius())) cell_pass(pass, i, current, next, exchanges);
+      if (std::isfinite(solids_[i].geometry.bounding_radius()))
+        cell_pass(pass, i, current, next, exchanges);
     double penetration = 0.0;
-    const bool inside = any_inside(next, penetration);
+    const bool inside = any_inside(pass, next, penetration);
     stats.max_penetration = penetration;
     if (!inside) break;
   }
@@ -1066,12 +1188,16 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
 
   if (any_free_) apply_impulses(exchanges);
+  // The velocities of the nodes the response moved: from the fields on the tiles it prepared,
+  // and from the walk on the others, where nothing moved them after the planes did. Only the
+  // moves after the walk need the stability check's edge test again.
   long local = 0;
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
-      if (!tile_touched_[tile(i, j)]) continue;
+      const std::size_t t = tile(i, j);
+      if (!ready_[t]) continue;
       const TileRange r = tile_nodes(i, j);
-      if (moved_rows != nullptr)
+      if (moved_rows != nullptr && tile_touched_[t])
         for (int l = r.l0; l < r.l1; ++l) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
       for (int l = r.l0; l < r.l1; ++l)
         for (int k = r.k0; k < r.k1; ++k)
@@ -1080,6 +1206,14 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
             ++local;
           }
     }
+  if (walked_)
+    for (int l = b.l0; l < b.l1; ++l)
+      for (const NodeVelocity& v : walk_settled_[static_cast<std::size_t>(l - b.l0)])
+        if (!ready_[tile((v.k - b.k0) / kTile, (l - b.l0) / kTile)]) {
+          corrected.push_back(v);
+          ++local;
+        }
+  walked_ = false;
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
   return stats;
 }

@@ -46,8 +46,8 @@ class Simulation::ContactAction final : public StepAction, public RowReader {
   }
   RowReader* row_reader() override { return this; }
   bool marks_moved_rows() const override { return true; }
-  void begin_walk() override { contact_->begin_walk(); }
-  void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next) override {
+  void begin_walk(double time, double dt) override { contact_->begin_walk(time, dt); }
+  void walk_row(int l, const Field<Vec3>& r, Field<Vec3>& next) override {
     contact_->walk_row(l, r, next);
   }
   void accepted() override {

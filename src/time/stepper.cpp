@@ -51,10 +51,12 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
   // the last step's (cloth lying on a floor), testing those again cost more than one pass
   // after them (docs/contact.md, "Cost"). Either way the same rows are found.
   edge_check_.arm(marked && !moved_most_);
+  // The actions' readers first: the contact moves nodes onto planes in the walk, and the edge
+  // test reads where they end.
   rows_.clear();
-  if (edge_check_.armed()) rows_.add(edge_check_);
   for (const auto& action : actions_)
     if (RowReader* reader = action->row_reader()) rows_.add(*reader);
+  if (edge_check_.armed()) rows_.add(edge_check_);
   if (auto solver_failure = scheme_->advance(step_)) {
     return Instability{step_ + 1, end_time, -1, -1, false, std::move(solver_failure), {}};
   }

@@ -64,13 +64,13 @@ void VerletFamily::centred_step(long step) {
   if (dynamics.fuses_rows()) {
     // Each row of a is used while the kernel still has it in cache, and never stored: the
     // step's largest sweep of memory saved (docs/kernel.md). The row is held, and the
-    // stability check's edge test and the contact's broad phase read it, while it is still
-    // there too.
+    // contact meets the planes with it and the stability check's edge test reads it while it
+    // is still there too.
     const double c = dynamics.row_velocity_terms().damping * weight / span;
     const Block& b = context_.block;
     const Constraints& constraints = context_.constraints;
     RowWalk* rows = context_.rows != nullptr && !context_.rows->empty() ? context_.rows : nullptr;
-    if (rows != nullptr) rows->begin_walk();
+    if (rows != nullptr) rows->begin_walk(context_.time, dt);
     dynamics.free_acceleration_rows(positions_, step, [&](int l, double* x, double* y, double* z) {
       const Vec3* r = &positions_(b.k0, l);
       const Vec3* rp = &previous_positions_(b.k0, l);

@@ -59,11 +59,12 @@ class Contact {
   ContactStats respond(double time, double dt, const Field<Vec3>& current, Field<Vec3>& next,
                        const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected,
                        std::vector<char>* moved_rows = nullptr);
-  // While a scheme's row walk still has them in cache: the broad phase's boxes from row l of
-  // the step's start and of its proposed end, from any thread, each row once. respond() then
-  // takes them rather than sweeping the nodes itself; a step without a walk leaves it to it.
-  void begin_walk() { walked_ = true; }
-  void walk_row(int l, const Field<Vec3>& current, const Field<Vec3>& next);
+  // While a scheme's row walk still has them in cache, for the step respond() is then called
+  // for (from `time` by `dt`, velocities (next − current)/dt): row l meets the planes and
+  // gives the broad phase its boxes, from any thread, each row once (docs/contact.md,
+  // "Cost"). A step without a walk leaves both to respond().
+  void begin_walk(double time, double dt);
+  void walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next);
 
   // The proposed step was accepted: the solids take their proposed state.
   void accept();
@@ -113,9 +114,16 @@ class Contact {
                                               const Field<Vec3>& current,
                                               const Field<Vec3>& next);
   // Sets a tile's velocities from the proposed step, once a response.
-  void prepare(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
+  void prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& next);
 
   void propose_free(Solid& s, double dt) const;
+  // Every solid's state at time + dt and what the broad phase needs of it.
+  void propose(double time, double dt);
+  // A plane met by a node whose proposed end is r, moving at v: r goes onto its offset surface
+  // and v takes the response (CONTACT.md §3), `surface` the plane's velocity there. False, and
+  // nothing changed, when r is clear of it.
+  [[gnu::always_inline]] inline bool meet_plane(const Solid& s, Vec3& r, Vec3& v,
+                                                Vec3& surface) const;
   // Inline, with remember() and settled_velocity(): run for every node in contact, their
   // Vec3 arguments passed through memory cost more than their arithmetic.
   [[gnu::always_inline]] inline Vec3 velocity_change(const Solid& s, const Vec3& surface,
@@ -138,7 +146,7 @@ class Contact {
                  std::vector<Exchange>& out);
   // Whether an owned node still sits inside a solid's offset layer (any rank); the deepest
   // any owned node sits inside a solid itself goes to `penetration`.
-  bool any_inside(const Field<Vec3>& next, double& penetration) const;
+  bool any_inside(int pass, const Field<Vec3>& next, double& penetration) const;
   void apply_impulses(std::vector<Exchange>& exchanges);
 
   std::vector<Solid> solids_;
@@ -165,7 +173,23 @@ class Contact {
   std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
   // Per owned row and tile column, from walk_row(): as boxes_, `moved` the largest squared move.
   std::vector<Box> row_boxes_;
-  bool walked_ = false;                      // walk_row() saw every row of this step
+  bool walked_ = false;    // walk_row() saw every row of this step
+  bool proposed_ = false;  // propose() ran for this step
+  // The planes, and then the other solids, each in scene order: the order a node meets them.
+  std::vector<std::size_t> order_;
+  std::size_t planes_ = 0;        // how many of order_ are planes
+  std::uint64_t plane_bits_ = 0;  // their bits (solid_bit)
+  // Per owned row, from walk_row(): the nodes a plane moved, with their proposed ends before;
+  // the velocities they leave with if nothing else moves them; whether a node was left inside
+  // a plane, and the deepest any sat inside one.
+  struct WalkTouch {
+    int k;
+    Vec3 proposed;
+  };
+  std::vector<std::vector<WalkTouch>> walk_touched_;
+  std::vector<std::vector<NodeVelocity>> walk_settled_;
+  std::vector<char> walk_inside_;
+  std::vector<double> walk_deepest_;
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes

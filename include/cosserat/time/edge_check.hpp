@@ -28,8 +28,12 @@ class EdgeCheck final : public RowReader {
   // A walk, in which each thread hands over the rows of r and r⁺ it has just finished, in
   // ascending order, held by the constraints. Tests the edges within the row's owned columns
   // and, if the same thread handed over the row below, the edges between the two.
-  void begin_walk() override;
-  void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next) override;
+  void begin_walk();
+  void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next);
+  void begin_walk(double /*time*/, double /*dt*/) override { begin_walk(); }
+  void walk_row(int l, const Field<Vec3>& r, Field<Vec3>& next) override {
+    walk_row(l, r, static_cast<const Field<Vec3>&>(next));
+  }
 
   // After the exchange of r⁺'s ghosts: per owned row, whether some edge of one of its nodes
   // may have changed too much (a NaN or infinity changes every edge of its node). What the walk

@@ -62,8 +62,9 @@ class StepAction {
   virtual void restore(const std::vector<double>& /*values*/) {}
   // What reads the scheme's rows as its walk finishes them (RowReader), or null.
   virtual RowReader* row_reader() { return nullptr; }
-  // Whether apply() marks every row it moved a node of in ProposedStep::moved_rows. Only when
-  // every action does may the stability check's edge test run in the walk, before them.
+  // Whether apply() marks every row it moved a node of in ProposedStep::moved_rows (moves its
+  // row_reader() made in the walk need no mark). Only when every action does may the stability
+  // check's edge test run in the walk, before them.
   virtual bool marks_moved_rows() const { return false; }
 };
 
