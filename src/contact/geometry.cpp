@@ -822,28 +822,9 @@ double SolidGeometry::lower_bound(const Vec3& a, const Vec3& b, const Vec3& c) c
                        smallest_magnitude(a.y, b.y, c.y) - h.y,
                        smallest_magnitude(a.z, b.z, c.z) - h.z});
     }
-    case ShapeKind::cylinder: {
-      const double radius = shape_.radius, half_length = shape_.half_length;
-      const double slabs = std::max(axis_distance(a, b, c) - radius,
-                                    smallest_magnitude(a.z, b.z, c.z) - half_length);
-      // Beyond the rim, where both slabs are passed, the distance is √(u² + w²) with
-      // u = ρ − R and w = |z| − h, at least αu + βw for any unit (α, β) ≥ 0, as it is
-      // everywhere else (there it is u, w or, inside, the larger of them, both ≤ 0 and
-      // α + β ≥ 1). With ρ ≥ e·x for a unit e across the axis and |z| ≥ ±z, that is linear on
-      // the triangle, least at a corner. (α, β) and e point to the centroid.
-      const Vec3 centroid = (a + b + c) / 3.0;
-      const double across = std::hypot(centroid.x, centroid.y);
-      const double u = across - radius, w = std::abs(centroid.z) - half_length;
-      if (!(u > 0.0 && w > 0.0)) return slabs;
-      const double length = std::hypot(u, w);
-      const double alpha = u / length, beta = w / length;
-      const double ex = centroid.x / across, ey = centroid.y / across;
-      const double side = centroid.z > 0.0 ? 1.0 : -1.0;
-      const auto linear = [&](const Vec3& p) {
-        return alpha * (ex * p.x + ey * p.y - radius) + beta * (side * p.z - half_length);
-      };
-      return std::max(slabs, std::min({linear(a), linear(b), linear(c)}));
-    }
+    case ShapeKind::cylinder:
+      return std::max(axis_distance(a, b, c) - shape_.radius,
+                      smallest_magnitude(a.z, b.z, c.z) - shape_.half_length);
     default:
       return -kInfinity;
   }

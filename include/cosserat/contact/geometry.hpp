@@ -117,8 +117,8 @@ class SolidGeometry {
 
   // A lower bound of the signed distance over triangle (a, b, c), cheap next to
   // deepest_point: for a box and a cylinder the largest of the distances to the slabs (and the
-  // infinite cylinder) whose intersection the solid is, each exact over the triangle, and for
-  // a cylinder beyond its rim a linear bound across the rim; −∞ for the other shapes.
+  // infinite cylinder) whose intersection the solid is, each exact over the triangle; −∞ for
+  // the other shapes.
   double lower_bound(const Vec3& a, const Vec3& b, const Vec3& c) const;
 
   // The radius of a ball about the frame's origin that holds the shape (infinite for a plane):
