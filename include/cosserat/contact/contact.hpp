@@ -55,7 +55,8 @@ class Contact {
   // (next − current)/dt. Moves owned nodes of `next` out of every solid (its ghosts are left
   // stale: the caller exchanges them), lists the changed velocities in `corrected`, and
   // proposes the solids' state at time + dt. Collective over the block's ranks.
-  // With `moved_rows` (per owned row), sets the rows it moved a node of.
+  // With `moved_rows` (per owned row), sets the rows it moved a node of since the walk, if
+  // there was one (the walk's own moves come before the edge test reads the rows).
   ContactStats respond(double time, double dt, const Field<Vec3>& current, Field<Vec3>& next,
                        const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected,
                        std::vector<char>* moved_rows = nullptr);
