@@ -179,6 +179,14 @@ void widen(Vec3& lo, Vec3& hi, const Vec3& p) {
 constexpr Vec3 kEmptyLow{kHuge, kHuge, kHuge};
 constexpr Vec3 kEmptyHigh{-kHuge, -kHuge, -kHuge};
 
+// A node's path from `start` to `end` into a box and the largest squared move.
+void widen_path(Vec3& lo, Vec3& hi, double& moved2, const Vec3& start, const Vec3& end) {
+  widen(lo, hi, start);
+  widen(lo, hi, end);
+  const Vec3 d = end - start;
+  moved2 = std::max(moved2, dot(d, d));
+}
+
 // The broad phase's tests allow for the round-off of the per-node tests they stand in for
 // (the frame's rotation), relative to the distances involved.
 constexpr double kBroadSlack = 1e-9;
@@ -334,13 +342,18 @@ Vec3 Contact::velocity_change(const Solid& s, const Vec3& surface, const Vec3& n
          velocity;
 }
 
+double Contact::leaving_speed(const Solid& s, const Vec3& n, const Vec3& surface,
+                              const Vec3& velocity) {
+  const double approach = dot(velocity - surface, n);
+  return approach < 0.0 ? -s.spec.restitution * approach : approach;
+}
+
 void Contact::remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& surface,
                        const Vec3& velocity) {
   touched_(k, l) |= s.spec.motion == SolidMotion::free ? kTouched | kByFreeBody : kTouched;
   contact_normal_(k, l) = n;
   surface_velocity_(k, l) = surface;
-  const double approach = dot(velocity - surface, n);
-  normal_speed_(k, l) = approach < 0.0 ? -s.spec.restitution * approach : approach;
+  normal_speed_(k, l) = leaving_speed(s, n, surface, velocity);
 }
 
 // docs/contact.md, "Velocities": the positions are what the next step starts from, so a
@@ -354,10 +367,13 @@ void Contact::remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& 
 Vec3 Contact::settled_velocity(int k, int l, const Field<Vec3>& current,
                                const Field<Vec3>& next) const {
   if (touched_(k, l) != kTouched) return velocity_(k, l);
-  const Vec3 n = contact_normal_(k, l);
-  const Vec3 moved = (next(k, l) - current(k, l)) / dt_;
-  const double normal = dot(moved - surface_velocity_(k, l), n);
-  return moved + (normal_speed_(k, l) - normal) * n;
+  return settled((next(k, l) - current(k, l)) / dt_, contact_normal_(k, l),
+                 surface_velocity_(k, l), normal_speed_(k, l));
+}
+
+Vec3 Contact::settled(const Vec3& moved, const Vec3& n, const Vec3& surface, double speed) {
+  const double normal = dot(moved - surface, n);
+  return moved + (speed - normal) * n;
 }
 
 // The step moved the node with its velocity before the response: friction's change of the
@@ -370,7 +386,7 @@ Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal) const {
 bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface) const {
   const Vec3& n = s.plane_normal;
   const double offset = s.spec.thickness;
-  const double d = dot(r - s.proposed.pose.position, n);
+  const double d = plane_height(s, r);
   if (d >= offset) return false;
   const Vec3 point = r + (offset - d) * n;
   surface = surface_velocity(s.proposed, point);
@@ -378,6 +394,20 @@ bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface) const 
   r = point + slip_correction(change, n);
   v = v + change;
   return true;
+}
+
+template <class Met>
+bool Contact::meet_planes(Vec3& r, Vec3& v, Met&& met) const {
+  bool any = false;
+  for (std::size_t o = 0; o < planes_; ++o) {
+    const Solid& s = solids_[order_[o]];
+    const Vec3 v_before = v;
+    Vec3 surface;
+    if (!meet_plane(s, r, v, surface)) continue;
+    met(s, surface, v_before);
+    any = true;
+  }
+  return any;
 }
 
 void Contact::record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
@@ -464,81 +494,72 @@ void Contact::make_box(int i, int j, const Field<Vec3>& current, const Field<Vec
   Box box{kEmptyLow, kEmptyHigh, 0.0};
   double moved2 = 0.0;
   for (int l = r.l0; l < r.l1; ++l)
-    for (int k = r.k0; k < r.k1; ++k) {
-      const Vec3 start = current(k, l), end = next(k, l);
-      widen(box.lo, box.hi, start);
-      widen(box.lo, box.hi, end);
-      const Vec3 d = end - start;
-      moved2 = std::max(moved2, dot(d, d));
-    }
+    for (int k = r.k0; k < r.k1; ++k) widen_path(box.lo, box.hi, moved2, current(k, l), next(k, l));
   box.moved = std::sqrt(moved2);
   const std::size_t t = tile(i, j);
   boxes_[t] = box;
   classify(t);
 }
 
-// Row l's part of each tile's box, as make_box finds it. A tile's rows can come from two
-// threads, so each row has its own. Vec3 is three packed doubles, so a full tile's nodes are
-// 24 interleaved doubles: their elementwise extremes and squared moves vectorise, and only the
-// folds onto x, y and z are scalar (a node-by-node loop cost 2.5 ns a node at 1024²).
 void Contact::begin_walk(double time, double dt) {
   propose(time, dt);
-  proposed_ = walked_ = true;
+  walked_ = true;
   dt_ = dt;
-  next_velocities_ = nullptr;
+}
+
+void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
+  if (planes_ > 0) walk_planes(l, current, next);
+  walk_boxes(l, current, next);
 }
 
 // The planes first (order_), each node's as node_pass meets them, while the row is in cache;
 // the velocity it leaves with, as settled_velocity() gives it, kept for when nothing after
-// moves it again, and its proposed end for prepare() when something may. Then the boxes, of
-// the moved row.
-void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
+// moves it again, and its proposed end for prepare() when something may.
+void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) {
+  const Block& b = *block_;
+  const auto row = static_cast<std::size_t>(l - b.l0);
+  std::vector<WalkTouch>& touched = walk_touched_[row];
+  std::vector<NodeVelocity>& settled_row = walk_settled_[row];
+  touched.clear();
+  settled_row.clear();
+  char inside = 0;
+  double deepest = 0.0;
+  for (int k = b.k0; k < b.k1; ++k) {
+    Vec3& r = next(k, l);
+    const Vec3 proposed = r;
+    const Vec3 start = current(k, l);
+    Vec3 v = (proposed - start) / dt_;
+    Vec3 normal, surface;
+    double speed = 0.0;
+    const bool met = meet_planes(r, v, [&](const Solid& s, const Vec3& at, const Vec3& v_before) {
+      normal = s.plane_normal;
+      surface = at;
+      speed = leaving_speed(s, normal, at, v_before);
+    });
+    if (!met) continue;
+    touched.push_back({k, proposed});
+    settled_row.push_back({k, l, settled((r - start) / dt_, normal, surface, speed)});
+    // any_inside()'s test of the planes, for the nodes they moved: the others are clear.
+    for (std::size_t o = 0; o < planes_; ++o) {
+      const Solid& s = solids_[order_[o]];
+      const double d = plane_height(s, r);
+      deepest = std::max(deepest, -d);
+      if (inside_offset(d, s.spec.thickness)) inside = 1;
+    }
+  }
+  walk_inside_[row] = inside;
+  walk_deepest_[row] = deepest;
+}
+
+// Row l's part of each tile's box, as make_box finds it, from the row as the planes left it.
+// A tile's rows can come from two threads, so each row has its own. Vec3 is three packed
+// doubles, so a full tile's nodes are 24 interleaved doubles: their elementwise extremes and
+// squared moves vectorise, and only the folds onto x, y and z are scalar (a node-by-node loop
+// cost 2.5 ns a node at 1024²).
+void Contact::walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double));
   constexpr int kValues = 3 * kTile;
   const Block& b = *block_;
-  if (planes_ > 0) {
-    const auto row = static_cast<std::size_t>(l - b.l0);
-    std::vector<WalkTouch>& touched = walk_touched_[row];
-    std::vector<NodeVelocity>& settled = walk_settled_[row];
-    touched.clear();
-    settled.clear();
-    char inside = 0;
-    double deepest = 0.0;
-    for (int k = b.k0; k < b.k1; ++k) {
-      Vec3& r = next(k, l);
-      const Vec3 proposed = r;
-      const Vec3 start = current(k, l);
-      Vec3 v = (proposed - start) / dt_;
-      Vec3 normal, surface;
-      double speed = 0.0;
-      bool met = false;
-      for (std::size_t o = 0; o < planes_; ++o) {
-        const Solid& s = solids_[order_[o]];
-        const Vec3 v_before = v;
-        Vec3 at;
-        if (!meet_plane(s, r, v, at)) continue;
-        met = true;
-        normal = s.plane_normal;
-        surface = at;
-        const double approach = dot(v_before - at, normal);
-        speed = approach < 0.0 ? -s.spec.restitution * approach : approach;
-      }
-      if (!met) continue;
-      touched.push_back({k, proposed});
-      const Vec3 moved = (r - start) / dt_;
-      settled.push_back({k, l, moved + (speed - dot(moved - surface, normal)) * normal});
-      // any_inside()'s test of the planes, for the nodes they moved: the others are clear.
-      for (std::size_t o = 0; o < planes_; ++o) {
-        const Solid& s = solids_[order_[o]];
-        const double offset = s.spec.thickness;
-        const double d = dot(r - s.proposed.pose.position, s.plane_normal);
-        deepest = std::max(deepest, -d);
-        if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
-      }
-    }
-    walk_inside_[row] = inside;
-    walk_deepest_[row] = deepest;
-  }
   Box* boxes = &row_boxes_[static_cast<std::size_t>(l - b.l0) * static_cast<std::size_t>(tiles_k_)];
   const double* start = &current(b.k0, l).x;
   const double* end = &next(b.k0, l).x;
@@ -546,14 +567,8 @@ void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
     const int first = i * kTile, nodes = std::min(kTile, b.owned_k() - first);
     if (nodes < kTile) {
       Box box{kEmptyLow, kEmptyHigh, 0.0};
-      for (int k = first; k < first + nodes; ++k) {
-        const Vec3 a{start[3 * k], start[3 * k + 1], start[3 * k + 2]};
-        const Vec3 e{end[3 * k], end[3 * k + 1], end[3 * k + 2]};
-        widen(box.lo, box.hi, a);
-        widen(box.lo, box.hi, e);
-        const Vec3 d = e - a;
-        box.moved = std::max(box.moved, dot(d, d));
-      }
+      for (int k = b.k0 + first; k < b.k0 + first + nodes; ++k)
+        widen_path(box.lo, box.hi, box.moved, current(k, l), next(k, l));
       boxes[i] = box;
       continue;
     }
@@ -626,13 +641,9 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
         Vec3& position = next(w.k, l);
         position = w.proposed;
         Vec3 v = (position - current(w.k, l)) / dt_;
-        for (std::size_t o = 0; o < planes_; ++o) {
-          const Solid& s = solids_[order_[o]];
-          const Vec3 v_before = v;
-          Vec3 surface;
-          if (meet_plane(s, position, v, surface))
-            remember(s, w.k, l, s.plane_normal, surface, v_before);
-        }
+        meet_planes(position, v, [&](const Solid& s, const Vec3& surface, const Vec3& v_before) {
+          remember(s, w.k, l, s.plane_normal, surface, v_before);
+        });
         velocity_(w.k, l) = v;
       }
   ready_[t] = 1;
@@ -1094,7 +1105,7 @@ bool Contact::any_inside(int pass, const Field<Vec3>& next, double& penetration)
             const double offset = s.spec.thickness;
             double d = 0.0;
             if (s.spec.shape.kind == ShapeKind::plane) {
-              d = dot(next(k, l) - s.proposed.pose.position, s.plane_normal);
+              d = plane_height(s, next(k, l));
             } else {
               if (norm(next(k, l) - s.proposed.pose.position) >
                   s.geometry.bounding_radius() + offset)
@@ -1102,8 +1113,7 @@ bool Contact::any_inside(int pass, const Field<Vec3>& next, double& penetration)
               d = s.geometry.closest(s.proposed.pose.to_local(next(k, l))).distance;
             }
             deepest = std::max(deepest, -d);
-            // Round-off of the projection onto the offset surface is not inside.
-            if (d < offset - 1e-9 * (offset + spacing_)) inside = 1;
+            if (inside_offset(d, offset)) inside = 1;
           }
     }
   penetration = std::max(penetration, deepest);
@@ -1148,8 +1158,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
                               std::vector<NodeVelocity>& corrected,
                               std::vector<char>* moved_rows) {
   const Block& b = *block_;
-  if (!proposed_) propose(time, dt);
-  proposed_ = false;
+  if (!walked_) propose(time, dt);
   dt_ = dt;
   // Each tile's box, from the scheme's row walk or a sweep of its own; the velocities only
   // where the response can need them (prepare): on tiles a solid can reach, and on the tiles

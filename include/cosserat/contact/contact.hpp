@@ -125,6 +125,22 @@ class Contact {
   // nothing changed, when r is clear of it.
   [[gnu::always_inline]] inline bool meet_plane(const Solid& s, Vec3& r, Vec3& v,
                                                 Vec3& surface) const;
+  // The planes in order against a node's proposed end r moving at v, as node_pass meets them,
+  // with met(s, surface, v_before) for each one met; whether any was.
+  template <class Met>
+  bool meet_planes(Vec3& r, Vec3& v, Met&& met) const;
+  // The height of r over plane s, along its normal.
+  static double plane_height(const Solid& s, const Vec3& r) {
+    return dot(r - s.proposed.pose.position, s.plane_normal);
+  }
+  // Whether a node at signed distance d sits inside a solid's offset layer: round-off of the
+  // projection onto the offset surface is not inside.
+  bool inside_offset(double d, double offset) const {
+    return d < offset - 1e-9 * (offset + spacing_);
+  }
+  // The walk's two parts (walk_row).
+  void walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next);
+  void walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next);
   // Inline, with remember() and settled_velocity(): run for every node in contact, their
   // Vec3 arguments passed through memory cost more than their arithmetic.
   [[gnu::always_inline]] inline Vec3 velocity_change(const Solid& s, const Vec3& surface,
@@ -141,6 +157,14 @@ class Contact {
   // The velocity touched node (k, l) leaves with (docs/contact.md, "Velocities").
   [[gnu::always_inline]] inline Vec3 settled_velocity(int k, int l, const Field<Vec3>& current,
                                                       const Field<Vec3>& next) const;
+  // Its formula, from the node's move over the step `moved` (as a velocity), the contact's
+  // normal n, the surface's velocity and the normal speed the response leaves it
+  // (leaving_speed(): e times the approach, or a leaving node's own).
+  [[gnu::always_inline]] static inline Vec3 settled(const Vec3& moved, const Vec3& n,
+                                                    const Vec3& surface, double speed);
+  [[gnu::always_inline]] static inline double leaving_speed(const Solid& s, const Vec3& n,
+                                                            const Vec3& surface,
+                                                            const Vec3& velocity);
   void node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                  std::vector<Exchange>& out);
   void cell_pass(int pass, std::size_t solid, const Field<Vec3>& current, Field<Vec3>& next,
@@ -174,8 +198,8 @@ class Contact {
   std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
   // Per owned row and tile column, from walk_row(): as boxes_, `moved` the largest squared move.
   std::vector<Box> row_boxes_;
-  bool walked_ = false;    // walk_row() saw every row of this step
-  bool proposed_ = false;  // propose() ran for this step
+  // walk_row() saw every row of this step, and begin_walk() proposed the solids' states.
+  bool walked_ = false;
   // The planes, and then the other solids, each in scene order: the order a node meets them.
   std::vector<std::size_t> order_;
   std::size_t planes_ = 0;        // how many of order_ are planes
