@@ -31,33 +31,30 @@ bool EdgeCheck::edge(int ka, int la, int kb, int lb, const Field<Vec3>& r,
   return changed(a.x, a.y, a.z, b.x, b.y, b.z, limit2_) != 0;
 }
 
-// Edges (la, la + 1) of columns [ka, kb).
-bool EdgeCheck::vertical(int la, int ka, int kb, const Field<Vec3>& r,
-                         const Field<Vec3>& next) const {
-  const Vec3 *p = &next(ka, la), *q = &r(ka, la);
-  const Vec3 *p_up = &next(ka, la + 1), *q_up = &r(ka, la + 1);
+// The edges from node i of (p, q) to node i of (p2, q2), i in [0, count): r⁺ and r at the
+// edges' two ends, each a run of a row.
+bool EdgeCheck::runs_changed(const Vec3* p, const Vec3* q, const Vec3* p2, const Vec3* q2,
+                             int count) const {
   const double limit2 = limit2_;
   int flagged = 0;
 #pragma omp simd reduction(| : flagged)
-  for (int i = 0; i < kb - ka; ++i)
+  for (int i = 0; i < count; ++i)
     flagged |= changed(p[i].x - q[i].x, p[i].y - q[i].y, p[i].z - q[i].z,
-                       p_up[i].x - q_up[i].x, p_up[i].y - q_up[i].y, p_up[i].z - q_up[i].z,
-                       limit2);
+                       p2[i].x - q2[i].x, p2[i].y - q2[i].y, p2[i].z - q2[i].z, limit2);
   return flagged != 0;
+}
+
+// Edges (la, la + 1) of columns [ka, kb).
+bool EdgeCheck::vertical(int la, int ka, int kb, const Field<Vec3>& r,
+                         const Field<Vec3>& next) const {
+  return runs_changed(&next(ka, la), &r(ka, la), &next(ka, la + 1), &r(ka, la + 1), kb - ka);
 }
 
 // The edges (k, l)–(k + 1, l) within the owned columns.
 bool EdgeCheck::horizontal(int l, const Field<Vec3>& r, const Field<Vec3>& next) const {
   const Block& b = *block_;
   const Vec3 *p = &next(b.k0, l), *q = &r(b.k0, l);
-  const double limit2 = limit2_;
-  int flagged = 0;
-#pragma omp simd reduction(| : flagged)
-  for (int i = 0; i < b.owned_k() - 1; ++i)
-    flagged |= changed(p[i].x - q[i].x, p[i].y - q[i].y, p[i].z - q[i].z,
-                       p[i + 1].x - q[i + 1].x, p[i + 1].y - q[i + 1].y,
-                       p[i + 1].z - q[i + 1].z, limit2);
-  return flagged != 0;
+  return runs_changed(p, q, p + 1, q + 1, b.owned_k() - 1);
 }
 
 void EdgeCheck::begin_walk() {

@@ -606,6 +606,20 @@ TEST(GeometryTest, DeepestPointOfABoxCornerIsTheCornersProjection) {
   EXPECT_NEAR(cube.closest(at(w, a, b, c)).distance, -0.05 / std::sqrt(3.0), 1e-12);
 }
 
+// The smallest signed distance to the shape over a lattice of triangle (a, b, c), `divisions`
+// steps along each side, its corners and edges included.
+double lattice_distance(const SolidGeometry& geometry, const Vec3& a, const Vec3& b, const Vec3& c,
+                        int divisions) {
+  double lattice = std::numeric_limits<double>::infinity();
+  for (int j = 0; j <= divisions; ++j)
+    for (int k = 0; j + k <= divisions; ++k) {
+      const std::array<double, 3> s{1.0 - double(j + k) / divisions, double(j) / divisions,
+                                    double(k) / divisions};
+      lattice = std::min(lattice, geometry.closest(at(s, a, b, c)).distance);
+    }
+  return lattice;
+}
+
 // Against the best of a fine lattice of the triangle: exact methods never lose to it, nor does
 // the cylinder's where the triangle presses into it; apart from it the cylinder's search may
 // stop a little short.
@@ -626,15 +640,7 @@ TEST(GeometryTest, DeepestPointBeatsAFineLattice) {
       EXPECT_NEAR(w[0] + w[1] + w[2], 1.0, 1e-14);
       EXPECT_GE(std::min({w[0], w[1], w[2]}), 0.0);
       const double found = geometry.closest(at(w, a, b, c)).distance;
-      constexpr int kDivisions = 80;
-      double lattice = std::numeric_limits<double>::infinity();
-      for (int j = 0; j <= kDivisions; ++j) {
-        for (int k = 0; j + k <= kDivisions; ++k) {
-          const std::array<double, 3> s{1.0 - double(j + k) / kDivisions, double(j) / kDivisions,
-                                        double(k) / kDivisions};
-          lattice = std::min(lattice, geometry.closest(at(s, a, b, c)).distance);
-        }
-      }
+      const double lattice = lattice_distance(geometry, a, b, c, 80);
       const double slack = shape.kind == ShapeKind::cylinder && lattice > 0.0 ? 1e-4 : 1e-12;
       EXPECT_LE(found, lattice + slack);
     }
@@ -658,15 +664,7 @@ TEST(GeometryTest, TheTrianglesLowerBoundHoldsEverywhereOnIt) {
       const Vec3 b = centre + random_vector(rng, size);
       const Vec3 c = centre + random_vector(rng, size);
       const double bound = geometry.lower_bound(a, b, c);
-      constexpr int kDivisions = 60;
-      double lattice = std::numeric_limits<double>::infinity();
-      for (int j = 0; j <= kDivisions; ++j)
-        for (int k = 0; j + k <= kDivisions; ++k) {
-          const std::array<double, 3> s{1.0 - double(j + k) / kDivisions, double(j) / kDivisions,
-                                        double(k) / kDivisions};
-          lattice = std::min(lattice, geometry.closest(at(s, a, b, c)).distance);
-        }
-      EXPECT_LE(bound, lattice + 1e-12) << "triangle " << i;
+      EXPECT_LE(bound, lattice_distance(geometry, a, b, c, 60) + 1e-12) << "triangle " << i;
     }
     // A small triangle over the top face, its corners 2, 3 and 5 mm above it.
     const double top = shape.kind == ShapeKind::box ? 0.3 : 0.6;

@@ -47,6 +47,8 @@ class EdgeCheck final : public RowReader {
   bool edge(int ka, int la, int kb, int lb, const Field<Vec3>& r, const Field<Vec3>& next) const;
   bool vertical(int la, int ka, int kb, const Field<Vec3>& r, const Field<Vec3>& next) const;
   bool horizontal(int l, const Field<Vec3>& r, const Field<Vec3>& next) const;
+  bool runs_changed(const Vec3* p, const Vec3* q, const Vec3* p2, const Vec3* q2,
+                    int count) const;
 
   const Block* block_;
   double limit2_;

@@ -17,7 +17,6 @@
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
 #include "cosserat/time/dynamics.hpp"
-#include "cosserat/time/edge_check.hpp"
 #include "cosserat/time/linear_solve_stats.hpp"
 #include "cosserat/time/row_walk.hpp"
 

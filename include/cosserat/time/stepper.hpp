@@ -13,6 +13,7 @@
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/constraints.hpp"
 #include "cosserat/time/dynamics.hpp"
+#include "cosserat/time/edge_check.hpp"
 #include "cosserat/time/row_walk.hpp"
 #include "cosserat/time/scheme.hpp"
 
