@@ -20,8 +20,8 @@ class VelocityScheme : public Scheme {
   Field<Vec3>* next_velocities() override { return &next_velocity_; }
   const Field<Vec3>& velocities() override { return velocity_; }
   std::vector<StateField> state_fields() override;
-  void set_velocities(const std::vector<NodeVelocity>& velocities) override {
-    for (const NodeVelocity& v : velocities) velocity_(v.k, v.l) = v.velocity;
+  void set_velocities(const NodeVelocities& velocities) override {
+    velocities.for_each([&](const NodeVelocity& v) { velocity_(v.k, v.l) = v.velocity; });
   }
 
  protected:

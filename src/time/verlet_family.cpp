@@ -126,9 +126,10 @@ void VerletFamily::accept_state() {
   dt_previous_ = context_.dt;
 }
 
-void VerletFamily::set_velocities(const std::vector<NodeVelocity>& velocities) {
-  for (const NodeVelocity& v : velocities)
+void VerletFamily::set_velocities(const NodeVelocities& velocities) {
+  velocities.for_each([&](const NodeVelocity& v) {
     previous_positions_(v.k, v.l) = positions_(v.k, v.l) - dt_previous_ * v.velocity;
+  });
   velocities_current_ = false;
 }
 

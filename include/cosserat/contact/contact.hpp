@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "cosserat/contact/geometry.hpp"
@@ -20,6 +21,34 @@ namespace cosserat {
 struct NodeVelocity {
   int k, l;
   Vec3 velocity;
+};
+
+// The velocities a step's actions set: a list of their own, then runs of lists an action keeps
+// until the step is accepted (the contact's walk keeps each row's), so that a response that
+// sets every node's velocity copies none of them (docs/contact.md, "Cost"). A node is in it
+// once.
+class NodeVelocities {
+ public:
+  void clear() {
+    own_.clear();
+    runs_.clear();
+  }
+  void push_back(const NodeVelocity& v) { own_.push_back(v); }
+  // `count` of another's list from `first`, which must hold until the step is accepted.
+  void add_run(const NodeVelocity* first, std::size_t count) {
+    if (count > 0) runs_.emplace_back(first, count);
+  }
+  bool empty() const { return own_.empty() && runs_.empty(); }
+  template <class Body>
+  void for_each(Body&& body) const {
+    for (const NodeVelocity& v : own_) body(v);
+    for (const std::span<const NodeVelocity>& run : runs_)
+      for (const NodeVelocity& v : run) body(v);
+  }
+
+ private:
+  std::vector<NodeVelocity> own_;
+  std::vector<std::span<const NodeVelocity>> runs_;
 };
 
 // The state of a solid at one time.
@@ -58,7 +87,7 @@ class Contact {
   // With `moved_rows` (per owned row), sets the rows it moved a node of since the walk, if
   // there was one (the walk's own moves come before the edge test reads the rows).
   ContactStats respond(double time, double dt, const Field<Vec3>& current, Field<Vec3>& next,
-                       const Field<Vec3>* next_velocities, std::vector<NodeVelocity>& corrected,
+                       const Field<Vec3>* next_velocities, NodeVelocities& corrected,
                        std::vector<char>* moved_rows = nullptr);
   // While a scheme's row walk still has them in cache, for the step respond() is then called
   // for (from `time` by `dt`, velocities (next − current)/dt): row l meets the planes and
@@ -129,15 +158,18 @@ class Contact {
   // with met(s, surface, v_before) for each one met; whether any was.
   template <class Met>
   bool meet_planes(Vec3& r, Vec3& v, Met&& met) const;
+  // The same for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's
+  // planes and prepare()'s meeting them again run this one function, so the same bits.
+  struct PlaneLanes;
+  [[gnu::noinline]] void meet_planes(PlaneLanes& lanes) const;
   // The height of r over plane s, along its normal.
   static double plane_height(const Solid& s, const Vec3& r) {
     return dot(r - s.proposed.pose.position, s.plane_normal);
   }
   // Whether a node at signed distance d sits inside a solid's offset layer: round-off of the
   // projection onto the offset surface is not inside.
-  bool inside_offset(double d, double offset) const {
-    return d < offset - 1e-9 * (offset + spacing_);
-  }
+  bool inside_offset(double d, double offset) const { return d < inside_level(offset); }
+  double inside_level(double offset) const { return offset - 1e-9 * (offset + spacing_); }
   // The walk's two parts (walk_row).
   void walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next);
   void walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next);
@@ -203,16 +235,20 @@ class Contact {
   // The planes, and then the other solids, each in scene order: the order a node meets them.
   std::vector<std::size_t> order_;
   std::size_t planes_ = 0;        // how many of order_ are planes
+  // Whether the walk finds the tiles' boxes: only a bounded solid needs them in a first pass.
+  bool walk_boxes_ = false;
   std::uint64_t plane_bits_ = 0;  // their bits (solid_bit)
   // Per owned row, from walk_row(): the nodes a plane moved, with their proposed ends before;
-  // the velocities they leave with if nothing else moves them; whether a node was left inside
-  // a plane, and the deepest any sat inside one.
+  // the velocities they leave with if nothing else moves them (the first walk_count_ of each
+  // row's, sized for every node of a row once); whether a node was left inside a plane, and
+  // the deepest any sat inside one.
   struct WalkTouch {
     int k;
     Vec3 proposed;
   };
   std::vector<std::vector<WalkTouch>> walk_touched_;
   std::vector<std::vector<NodeVelocity>> walk_settled_;
+  std::vector<int> walk_count_;
   std::vector<char> walk_inside_;
   std::vector<double> walk_deepest_;
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet

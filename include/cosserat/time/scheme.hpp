@@ -82,7 +82,7 @@ class Scheme {
   // After accept(): the listed owned nodes move on with these velocities (a contact
   // response's, CONTACT.md §3): a scheme that carries velocities takes them, the Verlet family
   // rewrites r⁻ so that (r − r⁻)/Δt is the given velocity.
-  virtual void set_velocities(const std::vector<NodeVelocity>& velocities) = 0;
+  virtual void set_velocities(const NodeVelocities& velocities) = 0;
 
   const Field<Vec3>& positions() const { return positions_; }
   Field<Vec3>& next_positions() { return next_positions_; }
@@ -143,7 +143,7 @@ class VerletFamily : public Scheme {
   VerletFamily(const StepContext& context, const Field<Vec3>& positions, Integrator scheme);
 
   std::optional<std::string> advance(long step) final;
-  void set_velocities(const std::vector<NodeVelocity>& velocities) override;
+  void set_velocities(const NodeVelocities& velocities) override;
   // The backward difference (r − r⁻)/Δt: the velocity half a step back.
   const Field<Vec3>& velocities() override;
   std::vector<StateField> state_fields() override;

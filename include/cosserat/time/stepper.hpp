@@ -42,7 +42,7 @@ struct ProposedStep {
   // its next step, whether it holds velocities or r⁻ (Scheme::set_velocities). The stepper's,
   // emptied for each step: a contact scene sets up to every node's, and allocating them every
   // step cost more than the response itself.
-  std::vector<NodeVelocity>& velocities;
+  NodeVelocities& velocities;
   // Per owned row, 0 on entry: an action that marks_moved_rows() sets the rows it moved nodes
   // of, so that the stability check tests only those again. Null when no check needs them.
   std::vector<char>* moved_rows = nullptr;
@@ -145,7 +145,7 @@ class Stepper {
   double time_ = 0.0;
   std::unique_ptr<Scheme> scheme_;
   std::vector<std::unique_ptr<StepAction>> actions_;
-  std::vector<NodeVelocity> set_velocities_;  // ProposedStep::velocities
+  NodeVelocities set_velocities_;  // ProposedStep::velocities
 };
 
 }  // namespace cosserat
