@@ -138,6 +138,14 @@ class Contact {
   // Sets near_ and spare_ of tile t from its box.
   void classify(std::size_t t);
   void make_box(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
+  // The cell pass's boxes (see contact.cpp).
+  struct CellBox {
+    Vec3 lo, hi;
+    double diagonal = 0.0;
+    bool cells = false;  // the tile answers for a cell
+  };
+  void make_cell_box(int i, int j, const Field<Vec3>& next);
+  void update_cell_boxes(const Field<Vec3>& next);
   // The same from the rows walk_row() saw.
   void merge_rows(int i, int j);
   [[gnu::always_inline]] inline void grow_box(std::size_t t, int k, int l,
@@ -254,6 +262,10 @@ class Contact {
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
+  // Per tile: its box grew since the cell boxes were found; and those boxes.
+  std::vector<unsigned char> grown_;
+  std::vector<CellBox> cell_boxes_;
+  bool cell_boxes_ready_ = false;  // found in this response
   std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
   std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
   const Field<Vec3>* next_velocities_ = nullptr;  // of the step being proposed, or null
