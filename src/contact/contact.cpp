@@ -452,10 +452,18 @@ void Contact::meet_planes(PlaneLanes& a) const {
     const double mu = s.spec.friction;
     const double bounce = -(1.0 + e);
     const double keep = -e;
+    // Most nodes of most scenes are clear of the floor: a plane no lane meets costs its heights.
+    double d[kLanes];
+    long any = 0;
+#pragma omp simd reduction(| : any)
+    for (int i = 0; i < kLanes; ++i) {
+      d[i] = (a.rx[i] - p.x) * n.x + (a.ry[i] - p.y) * n.y + (a.rz[i] - p.z) * n.z;
+      any |= d[i] >= offset ? 0 : 1;
+    }
+    if (!any) continue;
 #pragma omp simd
     for (int i = 0; i < kLanes; ++i) {
-      const double d = (a.rx[i] - p.x) * n.x + (a.ry[i] - p.y) * n.y + (a.rz[i] - p.z) * n.z;
-      const double lift = offset - d;
+      const double lift = offset - d[i];
       const double qx = a.rx[i] + lift * n.x, qy = a.ry[i] + lift * n.y,
                    qz = a.rz[i] + lift * n.z;
       const double cx = qx - p.x, cy = qy - p.y, cz = qz - p.z;
@@ -484,7 +492,7 @@ void Contact::meet_planes(PlaneLanes& a) const {
                    rz = qz + dt * (chz - cn * n.z);
       const double vx = a.vx[i] + chx, vy = a.vy[i] + chy, vz = a.vz[i] + chz;
       const double leaving = approaching ? keep * vn : vn;
-      const bool hit = !(d >= offset);
+      const bool hit = !(d[i] >= offset);
       a.rx[i] = hit ? rx : a.rx[i];
       a.ry[i] = hit ? ry : a.ry[i];
       a.rz[i] = hit ? rz : a.rz[i];
@@ -699,6 +707,9 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
       a.vx[i] = v.x, a.vy[i] = v.y, a.vz[i] = v.z;
     }
     meet_planes(a);
+    long any = 0;
+    for (int i = 0; i < kLanes; ++i) any |= a.met[i];
+    if (!any) continue;
     // settled() of the velocity the node leaves with, operation for operation, as
     // settled_velocity() finds it on a prepared tile.
 #pragma omp simd
