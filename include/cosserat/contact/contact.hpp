@@ -144,7 +144,7 @@ class Contact {
     double diagonal = 0.0;
     bool cells = false;  // the tile answers for a cell
   };
-  void make_cell_box(int i, int j, const Field<Vec3>& next);
+  CellBox cell_box(int i, int j, const Field<Vec3>& next) const;
   void update_cell_boxes(const Field<Vec3>& next);
   // The same from the rows walk_row() saw.
   void merge_rows(int i, int j);
@@ -262,7 +262,8 @@ class Contact {
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
-  // Per tile: its box grew since the cell boxes were found; and those boxes.
+  // Per tile: its box grew since the cell boxes were found; and those boxes, kept with more
+  // than one bounded solid.
   std::vector<unsigned char> grown_;
   std::vector<CellBox> cell_boxes_;
   bool cell_boxes_ready_ = false;  // found in this response
