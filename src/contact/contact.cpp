@@ -25,6 +25,8 @@ constexpr double kHuge = std::numeric_limits<double>::infinity();
 // What touched_ holds for a node: the response moved it; a free body was among the solids.
 constexpr unsigned char kTouched = 1;
 constexpr unsigned char kByFreeBody = 2;
+// The walk's planes moved it (prepare): alone, its velocity is the one the walk found.
+constexpr unsigned char kWalked = 4;
 
 // The spherical-linear interpolation from a to b at s in [0, 1], along the shorter arc.
 Quaternion slerp(Quaternion a, const Quaternion& b, double s) {
@@ -370,7 +372,7 @@ void Contact::remember(const Solid& s, int k, int l, const Vec3& n, const Vec3& 
 // are what the body took (apply_impulses).
 Vec3 Contact::settled_velocity(int k, int l, const Field<Vec3>& current,
                                const Field<Vec3>& next) const {
-  if (touched_(k, l) != kTouched) return velocity_(k, l);
+  if ((touched_(k, l) & ~kWalked) != kTouched) return velocity_(k, l);
   return settled((next(k, l) - current(k, l)) / dt_, contact_normal_(k, l),
                  surface_velocity_(k, l), normal_speed_(k, l));
 }
@@ -680,7 +682,7 @@ void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
 
 // The planes first (order_), each node's as node_pass meets them, while the row is in cache;
 // the velocity it leaves with, as settled_velocity() gives it, kept for when nothing after
-// moves it again, and its proposed end for prepare() when something may.
+// moves it again, and its velocity after the planes for prepare() when something may.
 void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) {
   const Block& b = *block_;
   const auto row = static_cast<std::size_t>(l - b.l0);
@@ -690,7 +692,7 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
   double inside_lanes[kLanes] = {}, deepest_lanes[kLanes] = {};
   const double rate = 1.0 / dt_;
   PlaneLanes a;
-  double sx[kLanes], sy[kLanes], sz[kLanes], px[kLanes], py[kLanes], pz[kLanes];
+  double sx[kLanes], sy[kLanes], sz[kLanes];
   double wx[kLanes], wy[kLanes], wz[kLanes];
   const Vec3* starts = &current(b.k0, l);
   Vec3* ends = &next(b.k0, l);
@@ -702,7 +704,6 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
       const Vec3 r = ends[k];
       const Vec3 start = starts[k];
       const Vec3 v = (r - start) / dt_;
-      px[i] = r.x, py[i] = r.y, pz[i] = r.z;
       sx[i] = start.x, sy[i] = start.y, sz[i] = start.z;
       a.rx[i] = r.x, a.ry[i] = r.y, a.rz[i] = r.z;
       a.vx[i] = v.x, a.vy[i] = v.y, a.vz[i] = v.z;
@@ -746,7 +747,7 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
         settled_row.resize(touched.size());
       }
       const int k = b.k0 + k0 + i;
-      touched[static_cast<std::size_t>(count)] = {k, {px[i], py[i], pz[i]}};
+      touched[static_cast<std::size_t>(count)] = {k, {a.vx[i], a.vy[i], a.vz[i]}};
       ends[k0 + i] = {a.rx[i], a.ry[i], a.rz[i]};
       settled_row[static_cast<std::size_t>(count)] = {k, l, {wx[i], wy[i], wz[i]}};
       ++count;
@@ -833,8 +834,9 @@ void Contact::grow_box(std::size_t t, int k, int l, const Field<Vec3>& current,
 }
 
 // A tile's velocities before the response moves any of its nodes. After a walk, the nodes it
-// moved onto planes are met by them again from their proposed ends, now into the fields the
-// response keeps: the same arithmetic on the same numbers, so the same bits.
+// moved onto planes take the velocities they left the planes with, marked kWalked: until a
+// later solid moves one (remember()), it leaves with the velocity the walk found, as on the
+// tiles never prepared.
 void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& next) {
   const std::size_t t = tile(i, j);
   if (ready_[t]) return;
@@ -852,34 +854,12 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
       const int count = walk_count_[row];
       // A row's touches are in k's order: a scan from its start cost the tiles along a row
       // quadratic time (46 % of prepare() on a sheet lying on a floor among other solids).
-      int next_touch = static_cast<int>(
-          std::lower_bound(w, w + count, r.k0,
-                           [](const WalkTouch& touch, int k) { return touch.k < k; }) -
-          w);
-      while (next_touch < count && w[next_touch].k < r.k1) {
-        // Up to kLanes of the tile's touched nodes, the last repeated in the lanes left.
-        PlaneLanes a;
-        int ks[kLanes];
-        int lanes = 0;
-        for (; lanes < kLanes && next_touch < count && w[next_touch].k < r.k1; ++lanes)
-          ks[lanes] = w[next_touch++].k;
-        for (int i = 0; i < kLanes; ++i) {
-          const WalkTouch& touch = w[next_touch - lanes + std::min(i, lanes - 1)];
-          const Vec3 v = (touch.proposed - current(touch.k, l)) / dt_;
-          a.rx[i] = touch.proposed.x, a.ry[i] = touch.proposed.y, a.rz[i] = touch.proposed.z;
-          a.vx[i] = v.x, a.vy[i] = v.y, a.vz[i] = v.z;
-        }
-        meet_planes(a);
-        for (int i = 0; i < lanes; ++i) {
-          const int k = ks[i];
-          next(k, l) = {a.rx[i], a.ry[i], a.rz[i]};
-          velocity_(k, l) = {a.vx[i], a.vy[i], a.vz[i]};
-          if (!a.met[i]) continue;
-          touched_(k, l) |= kTouched;
-          contact_normal_(k, l) = {a.nx[i], a.ny[i], a.nz[i]};
-          surface_velocity_(k, l) = {a.ux[i], a.uy[i], a.uz[i]};
-          normal_speed_(k, l) = a.speed[i];
-        }
+      for (const WalkTouch* touch =
+               std::lower_bound(w, w + count, r.k0,
+                                [](const WalkTouch& a, int k) { return a.k < k; });
+           touch < w + count && touch->k < r.k1; ++touch) {
+        velocity_(touch->k, l) = touch->velocity;
+        touched_(touch->k, l) = kWalked;
       }
     }
   ready_[t] = 1;
@@ -1438,58 +1418,54 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
 
   if (any_free_) apply_impulses(exchanges);
-  // The velocities of the nodes the response moved: from the fields on the tiles it prepared,
-  // and from the walk on the others, where nothing moved them after the planes did. Only the
-  // moves after the walk need the stability check's edge test again.
+  // The velocities of the nodes the response moved: the walk's rows as they are, for the nodes
+  // nothing moved after the planes did; the others' from the fields on the tiles it prepared,
+  // the walk's rows cut around them. Only the moves after the walk need the stability check's
+  // edge test again.
   long local = 0;
-  for (int j = 0; j < tiles_l_; ++j)
+  std::vector<int>& cuts = walk_cuts_;
+  for (int j = 0; j < tiles_l_; ++j) {
+    bool any_ready = false;
     for (int i = 0; i < tiles_k_; ++i) {
       const std::size_t t = tile(i, j);
       if (!ready_[t]) continue;
+      any_ready = true;
       const TileRange r = tile_nodes(i, j);
       if (moved_rows != nullptr && tile_touched_[t])
         for (int l = r.l0; l < r.l1; ++l) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
-      for (int l = r.l0; l < r.l1; ++l)
-        for (int k = r.k0; k < r.k1; ++k)
-          if (touched_(k, l)) {
-            corrected.push_back({k, l, settled_velocity(k, l, current, next)});
-            ++local;
-          }
     }
-  // The walk's rows go to the scheme as they are, cut only around the tiles prepared.
-  if (walked_)
-    for (int j = 0; j < tiles_l_; ++j) {
-      bool any_ready = false;
-      for (int i = 0; i < tiles_k_; ++i) any_ready = any_ready || ready_[tile(i, j)];
-      const TileRange rows = tile_nodes(0, j);
-      for (int l = rows.l0; l < rows.l1; ++l) {
-        const auto row = static_cast<std::size_t>(l - b.l0);
-        const NodeVelocity* settled_row = walk_settled_[row].data();
-        const int count = walk_count_[row];
-        local += count;
-        if (!any_ready) {
-          corrected.add_run(settled_row, static_cast<std::size_t>(count));
-          continue;
-        }
-        // Between the prepared tiles' nodes, found in the row's k order.
-        const auto at = [&](int k) {
-          return static_cast<int>(
-              std::lower_bound(settled_row, settled_row + count, k,
-                               [](const NodeVelocity& v, int key) { return v.k < key; }) -
-              settled_row);
-        };
-        int first = 0;
+    const TileRange rows = tile_nodes(0, j);
+    for (int l = rows.l0; l < rows.l1; ++l) {
+      cuts.clear();
+      if (any_ready)
         for (int i = 0; i < tiles_k_; ++i) {
           if (!ready_[tile(i, j)]) continue;
-          const TileRange nodes = tile_nodes(i, j);
-          const int from = at(nodes.k0), to = at(nodes.k1);
-          corrected.add_run(settled_row + first, static_cast<std::size_t>(from - first));
-          local -= to - from;
-          first = to;
+          const TileRange r = tile_nodes(i, j);
+          for (int k = r.k0; k < r.k1; ++k) {
+            const unsigned char touched = touched_(k, l);
+            if (touched == 0 || touched == kWalked) continue;
+            corrected.push_back({k, l, settled_velocity(k, l, current, next)});
+            ++local;
+            if (touched & kWalked) cuts.push_back(k);
+          }
         }
-        corrected.add_run(settled_row + first, static_cast<std::size_t>(count - first));
+      if (!walked_) continue;
+      const auto row = static_cast<std::size_t>(l - b.l0);
+      const NodeVelocity* settled_row = walk_settled_[row].data();
+      const int count = walk_count_[row];
+      local += count - static_cast<long>(cuts.size());
+      int first = 0;
+      for (const int k : cuts) {
+        const auto at = static_cast<int>(
+            std::lower_bound(settled_row, settled_row + count, k,
+                             [](const NodeVelocity& v, int key) { return v.k < key; }) -
+            settled_row);
+        corrected.add_run(settled_row + first, static_cast<std::size_t>(at - first));
+        first = at + 1;
       }
+      corrected.add_run(settled_row + first, static_cast<std::size_t>(count - first));
     }
+  }
   walked_ = false;
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
   return stats;

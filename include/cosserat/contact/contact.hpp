@@ -166,10 +166,9 @@ class Contact {
   // with met(s, surface, v_before) for each one met; whether any was.
   template <class Met>
   bool meet_planes(Vec3& r, Vec3& v, Met&& met) const;
-  // The same for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's
-  // planes and prepare()'s meeting them again run this one function, so the same bits.
+  // The same for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.
   struct PlaneLanes;
-  [[gnu::noinline]] void meet_planes(PlaneLanes& lanes) const;
+  void meet_planes(PlaneLanes& lanes) const;
   // The height of r over plane s, along its normal.
   static double plane_height(const Solid& s, const Vec3& r) {
     return dot(r - s.proposed.pose.position, s.plane_normal);
@@ -246,17 +245,18 @@ class Contact {
   // Whether the walk finds the tiles' boxes: only a bounded solid needs them in a first pass.
   bool walk_boxes_ = false;
   std::uint64_t plane_bits_ = 0;  // their bits (solid_bit)
-  // Per owned row, from walk_row(): the nodes a plane moved, with their proposed ends before;
-  // the velocities they leave with if nothing else moves them (the first walk_count_ of each
-  // row's, sized for every node of a row once); whether a node was left inside a plane, and
-  // the deepest any sat inside one.
+  // Per owned row, from walk_row(): the nodes a plane moved, with their velocities after it,
+  // for the response's fields where it goes on (prepare); the velocities they leave with if
+  // nothing else moves them (the first walk_count_ of each row's, sized for every node of a
+  // row once); whether a node was left inside a plane, and the deepest any sat inside one.
   struct WalkTouch {
     int k;
-    Vec3 proposed;
+    Vec3 velocity;
   };
   std::vector<std::vector<WalkTouch>> walk_touched_;
   std::vector<std::vector<NodeVelocity>> walk_settled_;
   std::vector<int> walk_count_;
+  std::vector<int> walk_cuts_;  // respond(): a row's walk nodes that moved again after it
   std::vector<char> walk_inside_;
   std::vector<double> walk_deepest_;
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
