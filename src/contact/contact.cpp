@@ -266,13 +266,12 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     near_.resize(tiles);
     spare_.resize(tiles);
     tile_touched_.resize(tiles);
-    grown_.resize(tiles);
     cells_near_.resize(tiles);
     ready_.resize(tiles);
     exchange_rows_.resize(static_cast<std::size_t>(tiles_l_));
     push_rows_.resize(static_cast<std::size_t>(tiles_l_));
     const auto rows = static_cast<std::size_t>(block.owned_l());
-    walk_touched_.resize(rows);
+    walk_velocity_.resize(rows);
     walk_settled_.resize(rows);
     walk_count_.resize(rows);
     walk_inside_.resize(rows);
@@ -288,7 +287,6 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
         }
       }
   walk_boxes_ = planes_ < solids.size();
-  if (planes_ + 1 < solids.size()) cell_boxes_.resize(boxes_.size());
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false, {}, {}, {}, {}, {}};
     if (spec.motion == SolidMotion::free) {
@@ -604,69 +602,14 @@ void Contact::make_box(int i, int j, const Field<Vec3>& current, const Field<Vec
   classify(t);
 }
 
-// The box of the nodes of the cells tile (i, j) answers for: its box and its next neighbours',
-// with the ghosts those cells reach.
-Contact::CellBox Contact::cell_box(int i, int j, const Field<Vec3>& next) const {
-  const Block& b = *block_;
-  const TileRange c = tile_cell_nodes(i, j);
-  Vec3 lo = kEmptyLow, hi = kEmptyHigh;
-  for (int dj = 0; dj < 2 && j + dj < tiles_l_; ++dj)
-    for (int di = 0; di < 2 && i + di < tiles_k_; ++di) {
-      const Box& box = boxes_[tile(i + di, j + dj)];
-      widen(lo, hi, box.lo);
-      widen(lo, hi, box.hi);
-    }
-  const auto ghost = [&](int k, int l) {
-    if (!b.owns(k, l)) widen(lo, hi, next(k, l));
-  };
-  if (c.k0 < b.k0 || c.k1 >= b.k1)
-    for (int l = c.l0; l <= c.l1; ++l) {
-      ghost(c.k0, l);
-      ghost(c.k1, l);
-    }
-  if (c.l0 < b.l0 || c.l1 >= b.l1)
-    for (int k = c.k0; k <= c.k1; ++k) {
-      ghost(k, c.l0);
-      ghost(k, c.l1);
-    }
-  return {lo, hi, norm(hi - lo), c.k1 > c.k0 && c.l1 > c.l0};
-}
-
-// With more than one bounded solid, every tile's cell box once a response, when the first cell
-// pass needs them; after that only those a grown tile's box is part of, and the block's border
-// tiles, whose ghosts each cell pass exchanges anew. Found for each solid from the tiles'
-// boxes, they cost ten solids at 1024² more than their cells' tests; kept for one solid, they
-// cost a sphere 0.8 ns a node-step more than found where they are used.
-void Contact::update_cell_boxes(const Field<Vec3>& next) {
-  const Block& b = *block_;
-  const auto border = [&](int i, int j) {
-    return (i == 0 && b.k0 > 0) || (j == 0 && b.l0 > 0) || (i == tiles_k_ - 1 && b.k1 < b.m) ||
-           (j == tiles_l_ - 1 && b.l1 < b.n);
-  };
-  if (!cell_boxes_ready_) {
-#pragma omp parallel for schedule(static)
-    for (int j = 0; j < tiles_l_; ++j)
-      for (int i = 0; i < tiles_k_; ++i) cell_boxes_[tile(i, j)] = cell_box(i, j, next);
-    std::fill(grown_.begin(), grown_.end(), 0);
-    cell_boxes_ready_ = true;
-    return;
-  }
-  for (int j = 0; j < tiles_l_; ++j)
-    for (int i = 0; i < tiles_k_; ++i) {
-      const std::size_t t = tile(i, j);
-      if (grown_[t]) {
-        // Tile (i, j) is part of the cell boxes of (i, j) and the tiles before it.
-        for (int dj = -1; dj <= 0; ++dj)
-          for (int di = -1; di <= 0; ++di)
-            if (i + di >= 0 && j + dj >= 0) grown_[tile(i + di, j + dj)] |= 2;
-      }
-    }
-  for (int j = 0; j < tiles_l_; ++j)
-    for (int i = 0; i < tiles_k_; ++i) {
-      const std::size_t t = tile(i, j);
-      if (grown_[t] || border(i, j)) cell_boxes_[t] = cell_box(i, j, next);
-      grown_[t] = 0;
-    }
+// A row's walk records are in k's order: the first from `from` on of a node at k or after. A
+// scan from the row's start made prepare() quadratic along a row (46 % of it with ten solids).
+int Contact::walk_at(std::size_t row, int from, int k) const {
+  const NodeVelocity* records = walk_settled_[row].data();
+  return static_cast<int>(
+      std::lower_bound(records + from, records + walk_count_[row], k,
+                       [](const NodeVelocity& v, int key) { return v.k < key; }) -
+      records);
 }
 
 void Contact::begin_walk(double time, double dt) {
@@ -686,7 +629,7 @@ void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
 void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) {
   const Block& b = *block_;
   const auto row = static_cast<std::size_t>(l - b.l0);
-  std::vector<WalkTouch>& touched = walk_touched_[row];
+  std::vector<Vec3>& after = walk_velocity_[row];
   std::vector<NodeVelocity>& settled_row = walk_settled_[row];
   int count = 0;
   double inside_lanes[kLanes] = {}, deepest_lanes[kLanes] = {};
@@ -742,12 +685,12 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
     }
     for (int i = 0; i < lanes; ++i) {
       if (!a.met[i]) continue;
-      if (touched.size() < static_cast<std::size_t>(b.owned_k())) {
-        touched.resize(static_cast<std::size_t>(b.owned_k()));
-        settled_row.resize(touched.size());
+      if (after.size() < static_cast<std::size_t>(b.owned_k())) {
+        after.resize(static_cast<std::size_t>(b.owned_k()));
+        settled_row.resize(after.size());
       }
       const int k = b.k0 + k0 + i;
-      touched[static_cast<std::size_t>(count)] = {k, {a.vx[i], a.vy[i], a.vz[i]}};
+      after[static_cast<std::size_t>(count)] = {a.vx[i], a.vy[i], a.vz[i]};
       ends[k0 + i] = {a.rx[i], a.ry[i], a.rz[i]};
       settled_row[static_cast<std::size_t>(count)] = {k, l, {wx[i], wy[i], wz[i]}};
       ++count;
@@ -830,7 +773,6 @@ void Contact::grow_box(std::size_t t, int k, int l, const Field<Vec3>& current,
   widen(box.lo, box.hi, next(k, l));
   box.moved = std::max(box.moved, norm(next(k, l) - current(k, l)));
   tile_touched_[t] = 1;
-  grown_[t] = 1;
 }
 
 // A tile's velocities before the response moves any of its nodes. After a walk, the nodes it
@@ -850,16 +792,11 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
   if (walked_)
     for (int l = r.l0; l < r.l1; ++l) {
       const auto row = static_cast<std::size_t>(l - block_->l0);
-      const WalkTouch* w = walk_touched_[row].data();
+      const NodeVelocity* walked = walk_settled_[row].data();
       const int count = walk_count_[row];
-      // A row's touches are in k's order: a scan from its start cost the tiles along a row
-      // quadratic time (46 % of prepare() on a sheet lying on a floor among other solids).
-      for (const WalkTouch* touch =
-               std::lower_bound(w, w + count, r.k0,
-                                [](const WalkTouch& a, int k) { return a.k < k; });
-           touch < w + count && touch->k < r.k1; ++touch) {
-        velocity_(touch->k, l) = touch->velocity;
-        touched_(touch->k, l) = kWalked;
+      for (int i = walk_at(row, 0, r.k0); i < count && walked[i].k < r.k1; ++i) {
+        velocity_(walked[i].k, l) = walk_velocity_[row][static_cast<std::size_t>(i)];
+        touched_(walked[i].k, l) = kWalked;
       }
     }
   ready_[t] = 1;
@@ -1068,30 +1005,38 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   // half the thickness plus the box's diagonal, which bounds every edge of those cells: the
   // per-triangle test below skips a triangle farther away than its longest edge plus that.
   const Vec3& centre = s.proposed.pose.position;
-  const bool kept = cell_boxes_.size() > 0;
-  if (kept) update_cell_boxes(next);
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
-      const CellBox box = kept ? cell_boxes_[tile(i, j)] : cell_box(i, j, next);
-      // A triangle that passes the per-triangle test farther from the solid's box than that
-      // finds its deepest point farther than the offset, and is not pressed in either. The
-      // slack, and the farthest point of the box it needs, only where it can decide: below,
-      // twice a bound of it by the 1-norm, which rounding cannot bring under it.
-      const double ball = box_gap(centre, centre, box.lo, box.hi) - radius - box.diagonal;
-      const double reach = box_gap(box.lo, box.hi, s.reach_lo, s.reach_hi) - box.diagonal;
-      bool near = box.cells && ball < flat_offset && reach < flat_offset;
-      if (box.cells && !near) {
-        const Vec3 d = centre - box.lo;
-        const double rough = 2.0 * kBroadSlack *
-                             (radius + std::abs(d.x) + std::abs(d.y) + std::abs(d.z) +
-                              box.diagonal);
-        if (ball < flat_offset + rough && reach < flat_offset + rough) {
-          const double slack = kBroadSlack * (radius + farthest_in(centre, box.lo, box.hi));
-          near = ball < flat_offset + slack && reach < flat_offset + slack;
+      const TileRange c = tile_cell_nodes(i, j);
+      Vec3 lo = kEmptyLow, hi = kEmptyHigh;
+      for (int dj = 0; dj < 2 && j + dj < tiles_l_; ++dj)
+        for (int di = 0; di < 2 && i + di < tiles_k_; ++di) {
+          const Box& box = boxes_[tile(i + di, j + dj)];
+          widen(lo, hi, box.lo);
+          widen(lo, hi, box.hi);
         }
-      }
-      cells_near_[tile(i, j)] = near;
+      const auto ghost = [&](int k, int l) {
+        if (!b.owns(k, l)) widen(lo, hi, next(k, l));
+      };
+      if (c.k0 < b.k0 || c.k1 >= b.k1)
+        for (int l = c.l0; l <= c.l1; ++l) {
+          ghost(c.k0, l);
+          ghost(c.k1, l);
+        }
+      if (c.l0 < b.l0 || c.l1 >= b.l1)
+        for (int k = c.k0; k <= c.k1; ++k) {
+          ghost(k, c.l0);
+          ghost(k, c.l1);
+        }
+      // A triangle that passes the per-triangle test farther from the solid's box than that
+      // finds its deepest point farther than the offset, and is not pressed in either.
+      const double diagonal = norm(hi - lo);
+      const double slack = kBroadSlack * (radius + farthest_in(centre, lo, hi));
+      cells_near_[tile(i, j)] =
+          c.k1 > c.k0 && c.l1 > c.l0 &&
+          box_gap(centre, centre, lo, hi) - radius - diagonal < flat_offset + slack &&
+          box_gap(lo, hi, s.reach_lo, s.reach_hi) - diagonal < flat_offset + slack;
     }
   // Whether a tile's nodes belong to a visited cell: its own cells, or those of the tiles
   // before it.
@@ -1377,13 +1322,11 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   next_velocities_ = next_velocities;
   const std::uint64_t first_pass = walked_ ? ~plane_bits_ : ~std::uint64_t{0};
   bool boxed = !walked_ || walk_boxes_;
-  cell_boxes_ready_ = false;
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
       const std::size_t t = tile(i, j);
       tile_touched_[t] = 0;
-      grown_[t] = 0;
       ready_[t] = 0;
       if (!walked_)
         make_box(i, j, current, next);
@@ -1456,10 +1399,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
       local += count - static_cast<long>(cuts.size());
       int first = 0;
       for (const int k : cuts) {
-        const auto at = static_cast<int>(
-            std::lower_bound(settled_row, settled_row + count, k,
-                             [](const NodeVelocity& v, int key) { return v.k < key; }) -
-            settled_row);
+        const int at = walk_at(row, first, k);
         corrected.add_run(settled_row + first, static_cast<std::size_t>(at - first));
         first = at + 1;
       }

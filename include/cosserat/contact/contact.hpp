@@ -138,14 +138,6 @@ class Contact {
   // Sets near_ and spare_ of tile t from its box.
   void classify(std::size_t t);
   void make_box(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
-  // The cell pass's boxes (see contact.cpp).
-  struct CellBox {
-    Vec3 lo, hi;
-    double diagonal = 0.0;
-    bool cells = false;  // the tile answers for a cell
-  };
-  CellBox cell_box(int i, int j, const Field<Vec3>& next) const;
-  void update_cell_boxes(const Field<Vec3>& next);
   // The same from the rows walk_row() saw.
   void merge_rows(int i, int j);
   [[gnu::always_inline]] inline void grow_box(std::size_t t, int k, int l,
@@ -180,6 +172,8 @@ class Contact {
   // The walk's two parts (walk_row).
   void walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next);
   void walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next);
+  // Row `row`'s first walk record from `from` on whose node is at k or after.
+  int walk_at(std::size_t row, int from, int k) const;
   // Inline, with remember() and settled_velocity(): run for every node in contact, their
   // Vec3 arguments passed through memory cost more than their arithmetic.
   [[gnu::always_inline]] inline Vec3 velocity_change(const Solid& s, const Vec3& surface,
@@ -245,16 +239,13 @@ class Contact {
   // Whether the walk finds the tiles' boxes: only a bounded solid needs them in a first pass.
   bool walk_boxes_ = false;
   std::uint64_t plane_bits_ = 0;  // their bits (solid_bit)
-  // Per owned row, from walk_row(): the nodes a plane moved, with their velocities after it,
-  // for the response's fields where it goes on (prepare); the velocities they leave with if
-  // nothing else moves them (the first walk_count_ of each row's, sized for every node of a
-  // row once); whether a node was left inside a plane, and the deepest any sat inside one.
-  struct WalkTouch {
-    int k;
-    Vec3 velocity;
-  };
-  std::vector<std::vector<WalkTouch>> walk_touched_;
+  // Per owned row, from walk_row(): the nodes a plane moved, with the velocities they leave
+  // with if nothing else moves them, in k's order; beside each, its velocity after the planes,
+  // for the response's fields where it goes on (prepare). The first walk_count_ of each row's,
+  // sized for every node of a row once. Whether a node was left inside a plane, and the
+  // deepest any sat inside one.
   std::vector<std::vector<NodeVelocity>> walk_settled_;
+  std::vector<std::vector<Vec3>> walk_velocity_;
   std::vector<int> walk_count_;
   std::vector<int> walk_cuts_;  // respond(): a row's walk nodes that moved again after it
   std::vector<char> walk_inside_;
@@ -262,11 +253,6 @@ class Contact {
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
-  // Per tile: its box grew since the cell boxes were found; and those boxes, kept with more
-  // than one bounded solid.
-  std::vector<unsigned char> grown_;
-  std::vector<CellBox> cell_boxes_;
-  bool cell_boxes_ready_ = false;  // found in this response
   std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
   std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
   const Field<Vec3>* next_velocities_ = nullptr;  // of the step being proposed, or null
