@@ -1,6 +1,7 @@
 #include "cosserat/contact/contact.hpp"
 
 #include <mpi.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <array>
@@ -263,6 +264,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     boxes_.resize(tiles);
     row_boxes_.resize(static_cast<std::size_t>(tiles_k_) *
                       static_cast<std::size_t>(block.owned_l()));
+    row_boxed_.resize(static_cast<std::size_t>(block.owned_l()));
     near_.resize(tiles);
     spare_.resize(tiles);
     tile_touched_.resize(tiles);
@@ -616,6 +618,11 @@ void Contact::begin_walk(double time, double dt) {
   propose(time, dt);
   walked_ = true;
   dt_ = dt;
+  if (walk_boxes_) {
+    box_runs_.resize(static_cast<std::size_t>(omp_get_max_threads()));
+    for (BoxRun& run : box_runs_) run.open = false;
+    std::fill(row_boxed_.begin(), row_boxed_.end(), 0);
+  }
 }
 
 void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
@@ -706,44 +713,77 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
   walk_deepest_[row] = deepest;
 }
 
-// Row l's part of each tile's box, as make_box finds it, from the row as the planes left it.
-// A tile's rows can come from two threads, so each row has its own. Vec3 is three packed
-// doubles, so a full tile's nodes are 24 interleaved doubles: their elementwise extremes and
-// squared moves vectorise, and only the folds onto x, y and z are scalar (a node-by-node loop
-// cost 2.5 ns a node at 1024²).
+// The tiles' boxes from the walk's rows, as the planes left them: each thread's run of rows of
+// a tile band is kept node slot by node slot, and folded onto x, y and z into row_boxes_ once,
+// on the run's last row (a tile band's last, or the thread's last of this step, closed before
+// the response). Vec3 is three packed doubles, so a full tile's nodes are 24 interleaved
+// doubles, whose elementwise extremes and squared moves vectorise; the fold is scalar (folded
+// on every row it cost 1.9 ns a node at 1024², node by node 2.5 ns). The largest move, summed
+// over the axes of each slot's largest moves along them, bounds the one make_box finds.
 void Contact::walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next) {
   static_assert(sizeof(Vec3) == 3 * sizeof(double));
   constexpr int kValues = 3 * kTile;
   const Block& b = *block_;
-  Box* boxes = &row_boxes_[static_cast<std::size_t>(l - b.l0) * static_cast<std::size_t>(tiles_k_)];
+  BoxRun& run = box_runs_[static_cast<std::size_t>(omp_get_thread_num())];
+  const auto values = static_cast<std::size_t>(kValues) * static_cast<std::size_t>(tiles_k_);
+  if (run.low.size() != values) {
+    run.low.resize(values);
+    run.high.resize(values);
+    run.square.resize(values);
+  }
+  const bool band_start = (l - b.l0) % kTile == 0;
+  if (run.open && (run.last != l - 1 || band_start)) close_box_run(run);
+  if (!run.open) {
+    std::fill(run.low.begin(), run.low.end(), kEmptyLow.x);
+    std::fill(run.high.begin(), run.high.end(), kEmptyHigh.x);
+    std::fill(run.square.begin(), run.square.end(), 0.0);
+    run.open = true;
+  }
+  run.last = l;
   const double* start = &current(b.k0, l).x;
   const double* end = &next(b.k0, l).x;
   for (int i = 0; i < tiles_k_; ++i) {
     const int first = i * kTile, nodes = std::min(kTile, b.owned_k() - first);
-    if (nodes < kTile) {
-      Box box{kEmptyLow, kEmptyHigh, 0.0};
-      for (int k = b.k0 + first; k < b.k0 + first + nodes; ++k)
-        widen_path(box.lo, box.hi, box.moved, current(k, l), next(k, l));
-      boxes[i] = box;
-      continue;
-    }
+    double* low = run.low.data() + static_cast<std::ptrdiff_t>(kValues) * i;
+    double* high = run.high.data() + static_cast<std::ptrdiff_t>(kValues) * i;
+    double* square = run.square.data() + static_cast<std::ptrdiff_t>(kValues) * i;
     const double* a = start + 3 * first;
     const double* e = end + 3 * first;
-    double low[kValues], high[kValues], square[kValues];
+    const int count = 3 * nodes;
+    // A short tile's last slots stay empty. Selects of values: std::min and std::max return a
+    // reference to one of their arguments, which GCC vectorised as gathers from memory.
 #pragma omp simd
-    for (int v = 0; v < kValues; ++v) {
-      low[v] = std::min(a[v], e[v]);
-      high[v] = std::max(a[v], e[v]);
-      const double d = e[v] - a[v];
-      square[v] = d * d;
+    for (int v = 0; v < count; ++v) {
+      const double from = a[v], to = e[v], d = to - from, d2 = d * d;
+      const double lo = low[v], hi = high[v], sq = square[v];
+      const double smaller = to < from ? to : from, larger = to < from ? from : to;
+      low[v] = smaller < lo ? smaller : lo;
+      high[v] = larger > hi ? larger : hi;
+      square[v] = d2 > sq ? d2 : sq;
     }
-    Box box{{low[0], low[1], low[2]}, {high[0], high[1], high[2]}, 0.0};
-    for (int v = 3; v < kValues; v += 3) widen(box.lo, box.hi, {low[v], low[v + 1], low[v + 2]});
-    for (int v = 3; v < kValues; v += 3) widen(box.lo, box.hi, {high[v], high[v + 1], high[v + 2]});
-    for (int v = 0; v < kValues; v += 3)
+  }
+  if ((l - b.l0) % kTile == kTile - 1 || l == b.l1 - 1) close_box_run(run);
+}
+
+void Contact::close_box_run(BoxRun& run) {
+  constexpr int kValues = 3 * kTile;
+  const Block& b = *block_;
+  Box* boxes =
+      &row_boxes_[static_cast<std::size_t>(run.last - b.l0) * static_cast<std::size_t>(tiles_k_)];
+  for (int i = 0; i < tiles_k_; ++i) {
+    const double* low = run.low.data() + static_cast<std::ptrdiff_t>(kValues) * i;
+    const double* high = run.high.data() + static_cast<std::ptrdiff_t>(kValues) * i;
+    const double* square = run.square.data() + static_cast<std::ptrdiff_t>(kValues) * i;
+    Box box{kEmptyLow, kEmptyHigh, 0.0};
+    for (int v = 0; v < kValues; v += 3) {
+      widen(box.lo, box.hi, {low[v], low[v + 1], low[v + 2]});
+      widen(box.lo, box.hi, {high[v], high[v + 1], high[v + 2]});
       box.moved = std::max(box.moved, square[v] + square[v + 1] + square[v + 2]);
+    }
     boxes[i] = box;
   }
+  row_boxed_[static_cast<std::size_t>(run.last - b.l0)] = 1;
+  run.open = false;
 }
 
 void Contact::merge_rows(int i, int j) {
@@ -752,6 +792,7 @@ void Contact::merge_rows(int i, int j) {
   Box box{kEmptyLow, kEmptyHigh, 0.0};
   double moved2 = 0.0;
   for (int l = r.l0; l < r.l1; ++l) {
+    if (!row_boxed_[static_cast<std::size_t>(l - b.l0)]) continue;
     const Box& row = row_boxes_[static_cast<std::size_t>(l - b.l0) *
                                     static_cast<std::size_t>(tiles_k_) +
                                 static_cast<std::size_t>(i)];
@@ -1001,9 +1042,10 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   halo_->exchange(next);
   halo_->exchange(velocity_);
   // The broad phase: a tile's cells are visited only when the box of their nodes (the tile's
-  // box and its next neighbours', ghosts added) comes closer to the ball holding the solid than
-  // half the thickness plus the box's diagonal, which bounds every edge of those cells: the
-  // per-triangle test below skips a triangle farther away than its longest edge plus that.
+  // box and its next neighbours', ghosts added) comes closer than half the thickness to the
+  // ball and to the box holding the solid. Every point of those cells lies in that box, and a
+  // triangle is pressed in only when its deepest point is closer than that (below): a tile
+  // farther away has no triangle to press in, whatever the per-triangle tests would find.
   const Vec3& centre = s.proposed.pose.position;
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
@@ -1029,14 +1071,11 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           ghost(k, c.l0);
           ghost(k, c.l1);
         }
-      // A triangle that passes the per-triangle test farther from the solid's box than that
-      // finds its deepest point farther than the offset, and is not pressed in either.
-      const double diagonal = norm(hi - lo);
       const double slack = kBroadSlack * (radius + farthest_in(centre, lo, hi));
       cells_near_[tile(i, j)] =
           c.k1 > c.k0 && c.l1 > c.l0 &&
-          box_gap(centre, centre, lo, hi) - radius - diagonal < flat_offset + slack &&
-          box_gap(lo, hi, s.reach_lo, s.reach_hi) - diagonal < flat_offset + slack;
+          box_gap(centre, centre, lo, hi) - radius < flat_offset + slack &&
+          box_gap(lo, hi, s.reach_lo, s.reach_hi) < flat_offset + slack;
     }
   // Whether a tile's nodes belong to a visited cell: its own cells, or those of the tiles
   // before it.
@@ -1322,6 +1361,9 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   next_velocities_ = next_velocities;
   const std::uint64_t first_pass = walked_ ? ~plane_bits_ : ~std::uint64_t{0};
   bool boxed = !walked_ || walk_boxes_;
+  if (walked_ && walk_boxes_)
+    for (BoxRun& run : box_runs_)
+      if (run.open) close_box_run(run);
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {

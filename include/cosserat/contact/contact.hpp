@@ -229,8 +229,20 @@ class Contact {
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
   int tiles_k_ = 0, tiles_l_ = 0;
   std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
-  // Per owned row and tile column, from walk_row(): as boxes_, `moved` the largest squared move.
+  // Per owned row and tile column, from walk_row(): as boxes_ for the rows of its tile band
+  // from its run's first to it, `moved` a bound of the largest squared move; only where
+  // row_boxed_ says a run ended on that row (walk_boxes).
   std::vector<Box> row_boxes_;
+  std::vector<unsigned char> row_boxed_;
+  // Per thread: its run of rows of one tile band so far, each tile column's 3 kTile values
+  // (x, y, z of each node slot) of the least, greatest and largest squared move of its nodes.
+  struct BoxRun {
+    int last = 0;
+    bool open = false;
+    std::vector<double> low, high, square;
+  };
+  std::vector<BoxRun> box_runs_;
+  void close_box_run(BoxRun& run);
   // walk_row() saw every row of this step, and begin_walk() proposed the solids' states.
   bool walked_ = false;
   // The planes, and then the other solids, each in scene order: the order a node meets them.
