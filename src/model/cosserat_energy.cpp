@@ -418,15 +418,19 @@ void CosseratEnergy::load_row(const Field<Vec3>& R, int l, int k_base, int k_end
 
 template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
 void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const {
-  const auto w = static_cast<std::size_t>(s.width);
-  const double* below = s.positions.data() + 3 * ((l - 1) % 3) * w;
-  const double* here = s.positions.data() + 3 * (l % 3) * w;
-  const double* above = s.positions.data() + 3 * ((l + 1) % 3) * w;
-  double* G = s.gradient.data();
-  double* N = s.normal.data();
-  const energy::InteriorCoefficients& co = interior_;
-  for (int block = ka - k_base; block < kb - k_base; block += kLanes) {
-#pragma omp simd
+  // A block's lanes as one vectorised loop, each unit through bounded_unit as Bounded says;
+  // whether any unit of the block was crushed. What the loop reads is local to it: read
+  // through the closure, GCC did not vectorise it.
+  const auto lanes = [this, l, &s]<bool Bounded>(int block) {
+    const auto w = static_cast<std::size_t>(s.width);
+    const double* below = s.positions.data() + 3 * ((l - 1) % 3) * w;
+    const double* here = s.positions.data() + 3 * (l % 3) * w;
+    const double* above = s.positions.data() + 3 * ((l + 1) % 3) * w;
+    double* G = s.gradient.data();
+    double* N = s.normal.data();
+    const energy::InteriorCoefficients& co = interior_;
+    long crushed = 0;
+#pragma omp simd reduction(| : crushed)
     for (int lane = 0; lane < kLanes; ++lane) {
       const std::size_t c = static_cast<std::size_t>(block + lane);
       auto at = [&](const double* row, std::size_t i) {
@@ -434,12 +438,12 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
       };
       Vec3 n;
       const energy::InteriorGradient g =
-          Trapezoidal ? energy::trapezoidal_gradient<Bending, Coupling, Normal>(
+          Trapezoidal ? energy::trapezoidal_gradient<Bending, Coupling, Normal, Bounded>(
                             co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c),
-                            at(below, c), at(above, c + 1), n)
-                      : energy::interior_gradient<Bending, Coupling, Normal>(
+                            at(below, c), at(above, c + 1), n, crushed)
+                      : energy::interior_gradient<Bending, Coupling, Normal, Bounded>(
                             co, at(here, c), at(here, c + 1), at(here, c - 1), at(above, c),
-                            at(below, c), at(above, c + 1), n);
+                            at(below, c), at(above, c + 1), n, crushed);
       // Slot by slot: an array of pointers into g would give each lane's g an address, and
       // the loop would not vectorise.
       auto store = [&](int q, const Vec3& v) {
@@ -459,7 +463,13 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
         N[2 * w + c] = n.z;
       }
     }
-  }
+    return crushed != 0;
+  };
+  // Where no unit of a block is crushed, the unbounded units are the bounded ones, bit for
+  // bit, and cheaper: the bound taken everywhere cost the kernel 10-18 % (docs/equations.md,
+  // "Crushed cells"). A block where one is crushed is done again, bounded.
+  for (int block = ka - k_base; block < kb - k_base; block += kLanes)
+    if (lanes.template operator()<false>(block)) lanes.template operator()<true>(block);
 }
 
 // One border node through node_energy, into the row buffers.

@@ -31,13 +31,28 @@ struct Unit {
   double rho;      // g g′(|c|)/|c|: 1 where c is not crushed
 };
 
-[[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush) {
+//
+// Unbounded, it is c/|c| whether crushed or not, and `crushed` says whether c was: the kernel
+// takes that form for a block of nodes where none is, and there the bits are the same, without
+// the blend's arithmetic and selects (interior_row).
+template <bool Bounded>
+[[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush, long& crushed) {
   const double length2 = dot(c, c);
   const double y = length2 * crush.inverse_delta2;
-  const bool crushed = y < 1.0;
+  const bool below = y < 1.0;
+  if constexpr (!Bounded) {
+    crushed |= below ? 1 : 0;
+    const double inverse = 1.0 / std::sqrt(length2);
+    return {c * inverse, inverse, 1.0};
+  }
   const double blend = 0.375 + y * (0.75 - 0.125 * y);
-  const double inverse = 1.0 / (crushed ? crush.delta * blend : std::sqrt(length2));
-  return {c * inverse, inverse, crushed ? 0.5 * blend * (3.0 - y) : 1.0};
+  const double inverse = 1.0 / (below ? crush.delta * blend : std::sqrt(length2));
+  return {c * inverse, inverse, below ? 0.5 * blend * (3.0 - y) : 1.0};
+}
+
+[[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush) {
+  long crushed = 0;
+  return bounded_unit<true>(c, crush, crushed);
 }
 
 // Back through u = c/g: ∂/∂c of G_u · u.
@@ -46,8 +61,15 @@ struct Unit {
 }
 
 // One corner triangle of §2.1 rule 2: edges E, F from p and the unit of c = E × F.
+template <bool Bounded = true>
+[[gnu::always_inline]] inline Unit corner(const Vec3& E, const Vec3& F, const Crush& crush,
+                                          long& crushed) {
+  return bounded_unit<Bounded>(cross(E, F), crush, crushed);
+}
+
 [[gnu::always_inline]] inline Unit corner(const Vec3& E, const Vec3& F, const Crush& crush) {
-  return bounded_unit(cross(E, F), crush);
+  long crushed = 0;
+  return corner<true>(E, F, crush, crushed);
 }
 
 // Back through a corner's unit and c = E × F: ∂/∂r of G_s · u at its edges' far nodes; at p it
@@ -65,11 +87,12 @@ struct CornerGradient {
 
 // Positions of p = (k, l), its neighbours and (k+1, l+1); the unit normal n of p comes back in
 // `normal` when the bending terms or the caller (Normal: the fluid term reads it) need it. The
-// symbols are InteriorCoefficients'.
-template <bool Bending, bool Coupling, bool Normal>
+// symbols are InteriorCoefficients'. Unbounded (Bounded false), every unit is c/|c| and
+// `crushed` is set where one was crushed (bounded_unit).
+template <bool Bending, bool Coupling, bool Normal, bool Bounded>
 [[gnu::always_inline]] inline InteriorGradient interior_gradient(
     const InteriorCoefficients& c, const Vec3& r, const Vec3& r_right, const Vec3& r_left,
-    const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal) {
+    const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal, long& crushed) {
   // ∂E_p/∂r at the five slots other than p, built up term by term.
   Vec3 g_right, g_left, g_up, g_down, g_up_right;
   // §2.1 rule 1: a_α = D_α / h_α, so ε_αβ = ½ (a_α · a_β − A_αβ) = e_αβ D_α · D_β − ½A_αβ.
@@ -83,9 +106,12 @@ template <bool Bending, bool Coupling, bool Normal>
     // §2.1 rule 2: n = s/|s|, s the sum of the four corner triangles' unit normals (each
     // through bounded_unit).
     const Vec3 left = r_left - r, down = r_down - r;
-    const Unit q0 = corner(right, up, c.corner), q1 = corner(up, left, c.corner),
-               q2 = corner(left, down, c.corner), q3 = corner(down, right, c.corner);
-    const Unit sum = bounded_unit(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum);
+    const Unit q0 = corner<Bounded>(right, up, c.corner, crushed),
+               q1 = corner<Bounded>(up, left, c.corner, crushed),
+               q2 = corner<Bounded>(left, down, c.corner, crushed),
+               q3 = corner<Bounded>(down, right, c.corner, crushed);
+    const Unit sum =
+        bounded_unit<Bounded>(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum, crushed);
     const Vec3 n = sum.unit;
     normal = n;
 
@@ -142,10 +168,10 @@ template <bool Bending, bool Coupling, bool Normal>
 // interior node's E_p is its bending terms, the stretch of its two forward edges and the cell
 // (k+½, l+½), all of weight 1; it reads the same six nodes. The coefficients are
 // trapezoidal_coefficients' (cosserat_energy.cpp), and trapezoidal_energy is the general form.
-template <bool Bending, bool Coupling, bool Normal>
+template <bool Bending, bool Coupling, bool Normal, bool Bounded>
 [[gnu::always_inline]] inline InteriorGradient trapezoidal_gradient(
     const InteriorCoefficients& c, const Vec3& r, const Vec3& r_right, const Vec3& r_left,
-    const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal) {
+    const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal, long& crushed) {
   Vec3 g_right, g_left, g_up, g_down, g_up_right;
   const Vec3 right = r_right - r, up = r_up - r, diagonal = r_up_right - r;
   const double eps11 = c.e[0] * dot(right, right) - c.half_A[0];
@@ -158,9 +184,12 @@ template <bool Bending, bool Coupling, bool Normal>
 
   if (Bending || Normal) {
     const Vec3 left = r_left - r, down = r_down - r;
-    const Unit q0 = corner(right, up, c.corner), q1 = corner(up, left, c.corner),
-               q2 = corner(left, down, c.corner), q3 = corner(down, right, c.corner);
-    const Unit sum = bounded_unit(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum);
+    const Unit q0 = corner<Bounded>(right, up, c.corner, crushed),
+               q1 = corner<Bounded>(up, left, c.corner, crushed),
+               q2 = corner<Bounded>(left, down, c.corner, crushed),
+               q3 = corner<Bounded>(down, right, c.corner, crushed);
+    const Unit sum =
+        bounded_unit<Bounded>(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum, crushed);
     const Vec3 n = sum.unit;
     normal = n;
 
@@ -202,7 +231,7 @@ template <bool Bending, bool Coupling, bool Normal>
 
       // The cell's twist: κ₁₂ = −n_c · X/(h₁h₂), n_c = t₁ × t₂ normalised.
       const Vec3 X = (diagonal - right) - up;
-      const Unit cell = bounded_unit(cross(t1, t2), c.cell);
+      const Unit cell = bounded_unit<Bounded>(cross(t1, t2), c.cell, crushed);
       const double beta12 = dot(cell.unit, X);
       double mu12 = c.mu_beta[1] * beta12;
       if (Coupling) {
