@@ -774,10 +774,14 @@ void Contact::close_box_run(BoxRun& run) {
     const double* low = run.low.data() + static_cast<std::ptrdiff_t>(kValues) * i;
     const double* high = run.high.data() + static_cast<std::ptrdiff_t>(kValues) * i;
     const double* square = run.square.data() + static_cast<std::ptrdiff_t>(kValues) * i;
+    // Lows into lo and highs into hi: a short tile's empty slots (lows +∞, highs −∞) would
+    // make a box of everything as points.
     Box box{kEmptyLow, kEmptyHigh, 0.0};
     for (int v = 0; v < kValues; v += 3) {
-      widen(box.lo, box.hi, {low[v], low[v + 1], low[v + 2]});
-      widen(box.lo, box.hi, {high[v], high[v + 1], high[v + 2]});
+      box.lo = {std::min(box.lo.x, low[v]), std::min(box.lo.y, low[v + 1]),
+                std::min(box.lo.z, low[v + 2])};
+      box.hi = {std::max(box.hi.x, high[v]), std::max(box.hi.y, high[v + 1]),
+                std::max(box.hi.z, high[v + 2])};
       box.moved = std::max(box.moved, square[v] + square[v + 1] + square[v + 2]);
     }
     boxes[i] = box;
