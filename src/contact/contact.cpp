@@ -179,6 +179,12 @@ void widen(Vec3& lo, Vec3& hi, const Vec3& p) {
   lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
   hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
 }
+// The box [lo, hi] grown to hold the box [other_lo, other_hi], which may be empty (lows +∞,
+// highs −∞): widened by its corners as points, an empty one would make a box of everything.
+void enclose(Vec3& lo, Vec3& hi, const Vec3& other_lo, const Vec3& other_hi) {
+  lo = {std::min(lo.x, other_lo.x), std::min(lo.y, other_lo.y), std::min(lo.z, other_lo.z)};
+  hi = {std::max(hi.x, other_hi.x), std::max(hi.y, other_hi.y), std::max(hi.z, other_hi.z)};
+}
 constexpr Vec3 kEmptyLow{kHuge, kHuge, kHuge};
 constexpr Vec3 kEmptyHigh{-kHuge, -kHuge, -kHuge};
 
@@ -774,14 +780,11 @@ void Contact::close_box_run(BoxRun& run) {
     const double* low = run.low.data() + static_cast<std::ptrdiff_t>(kValues) * i;
     const double* high = run.high.data() + static_cast<std::ptrdiff_t>(kValues) * i;
     const double* square = run.square.data() + static_cast<std::ptrdiff_t>(kValues) * i;
-    // Lows into lo and highs into hi: a short tile's empty slots (lows +∞, highs −∞) would
-    // make a box of everything as points.
+    // Each slot is a box of its own, empty in a short tile's last slots.
     Box box{kEmptyLow, kEmptyHigh, 0.0};
     for (int v = 0; v < kValues; v += 3) {
-      box.lo = {std::min(box.lo.x, low[v]), std::min(box.lo.y, low[v + 1]),
-                std::min(box.lo.z, low[v + 2])};
-      box.hi = {std::max(box.hi.x, high[v]), std::max(box.hi.y, high[v + 1]),
-                std::max(box.hi.z, high[v + 2])};
+      enclose(box.lo, box.hi, {low[v], low[v + 1], low[v + 2]},
+              {high[v], high[v + 1], high[v + 2]});
       box.moved = std::max(box.moved, square[v] + square[v + 1] + square[v + 2]);
     }
     boxes[i] = box;
@@ -800,8 +803,7 @@ void Contact::merge_rows(int i, int j) {
     const Box& row = row_boxes_[static_cast<std::size_t>(l - b.l0) *
                                     static_cast<std::size_t>(tiles_k_) +
                                 static_cast<std::size_t>(i)];
-    widen(box.lo, box.hi, row.lo);
-    widen(box.lo, box.hi, row.hi);
+    enclose(box.lo, box.hi, row.lo, row.hi);
     moved2 = std::max(moved2, row.moved);
   }
   box.moved = std::sqrt(moved2);
@@ -1059,8 +1061,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       for (int dj = 0; dj < 2 && j + dj < tiles_l_; ++dj)
         for (int di = 0; di < 2 && i + di < tiles_k_; ++di) {
           const Box& box = boxes_[tile(i + di, j + dj)];
-          widen(lo, hi, box.lo);
-          widen(lo, hi, box.hi);
+          enclose(lo, hi, box.lo, box.hi);
         }
       const auto ghost = [&](int k, int l) {
         if (!b.owns(k, l)) widen(lo, hi, next(k, l));

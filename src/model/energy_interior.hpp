@@ -31,8 +31,7 @@ struct Unit {
   double rho;      // g g′(|c|)/|c|: 1 where c is not crushed
 };
 
-//
-// Unbounded, it is c/|c| whether crushed or not, and `crushed` says whether c was: the kernel
+// Unbounded, u is c/|c| whether crushed or not, and `crushed` says whether c was: the kernel
 // takes that form for a block of nodes where none is, and there the bits are the same, without
 // the blend's arithmetic and selects (interior_row).
 template <bool Bounded>
@@ -61,7 +60,7 @@ template <bool Bounded>
 }
 
 // One corner triangle of §2.1 rule 2: edges E, F from p and the unit of c = E × F.
-template <bool Bounded = true>
+template <bool Bounded>
 [[gnu::always_inline]] inline Unit corner(const Vec3& E, const Vec3& F, const Crush& crush,
                                           long& crushed) {
   return bounded_unit<Bounded>(cross(E, F), crush, crushed);

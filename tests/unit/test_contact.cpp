@@ -93,7 +93,7 @@ double slide_acceleration(double theta, double mu, double* drift_when_stuck, lon
 // same response: on a crumpled sheet of 37 x 29 nodes (tiles cut at the borders) sinking into a
 // floor, a moving tilted plane, a sphere and a box, the proposed ends, the velocities the
 // moved nodes leave with and the step's figures are bitwise those of respond() alone, with
-// the rows walked in one band or in two (two threads' order). With planes alone the walk finds
+// the rows walked in one band, two or three (threads' orders). With planes alone the walk finds
 // no boxes; a ceiling that faces the floor below the floor's surface leaves nodes inside, so
 // that the passes after the first find the boxes then, and meet the planes again.
 void expect_the_walk_gives_the_response_alone(const std::vector<SolidSpec>& solids,
