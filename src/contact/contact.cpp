@@ -1177,7 +1177,8 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
             // The deepest point's distance is at least the bound, and the offset below at
             // most flat_offset (rounded: the slack).
             if (g.lower_bound(p[0], p[1], p[2]) >= flat_offset + bound_slack) continue;
-            const std::array<double, 3> w = g.deepest_point(p[0], p[1], p[2]);
+            const std::array<double, 3> w =
+                g.deepest_point(p[0], p[1], p[2], flat_offset + bound_slack);
             if (std::max({w[0], w[1], w[2]}) >= 1.0 - 1e-12) continue;  // a node: node_pass's
             const Vec3 point = w[0] * p[0] + w[1] * p[1] + w[2] * p[2];
             const Closest c = g.closest(point);

@@ -350,11 +350,18 @@ constexpr int kRoundSegments = 32;
 // halved whenever no move lowers the distance. It uses values only (the distance inside a
 // box or a cylinder has kinks where gradients jump) and never raises the distance; on a kink
 // not aligned with any of its six directions it can stop short of the minimum.
-template <typename Distance>
-Weights compass_refine(Weights w, double value, const Distance& distance) {
+//
+// `far_enough(w, value)` is asked before each step size: when it says yes the search stops
+// where it is.
+template <typename Distance, typename FarEnough>
+Weights compass_refine(Weights w, double value, const Distance& distance,
+                       const FarEnough& far_enough) {
   constexpr double kSmallestStep = 1.0 / (1 << 16);
   double step = 0.25;
+  bool asked = false;
   while (step >= kSmallestStep) {
+    if (!asked && far_enough(w, value)) break;
+    asked = true;
     bool moved = false;
     for (int from = 0; from < 3 && !moved; ++from) {
       for (int to = 0; to < 3 && !moved; ++to) {
@@ -371,7 +378,10 @@ Weights compass_refine(Weights w, double value, const Distance& distance) {
         }
       }
     }
-    if (!moved) step *= 0.5;
+    if (!moved) {
+      step *= 0.5;
+      asked = false;
+    }
   }
   return w;
 }
@@ -538,7 +548,7 @@ Weights cylinder_pressed(double radius, double half_length, const Vec3& a, const
 // is round at the rims, so candidates (the triangle's corners, its points nearest the centre,
 // the axis and rim samples) and a compass search from the best cover that.
 Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const Vec3& b,
-                         const Vec3& c) {
+                         const Vec3& c, double floor) {
   // Beside the side, away from the caps, the distance is ρ − R, ρ the distance from the axis:
   // the deepest point is then the point of the triangle's shadow on the xy-plane nearest the
   // axis, in closed form. That holds when every corner is within |z| <= H (so is the whole
@@ -616,7 +626,16 @@ Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const
       best = pressed;
     }
   }
-  return clean(compass_refine(best, best_value, distance));
+  // The signed distance to a convex solid is convex, so over the triangle it is at least its
+  // value at any point w plus the least reach of its normal there towards the corners: once
+  // that is `floor`, no point of the triangle comes closer and the search may stop.
+  const auto far_enough = [&](const Weights& w, double value) {
+    if (value < floor) return false;
+    const Vec3 p = at(w, a, b, c);
+    const Vec3 n = cylinder_closest(p, radius, half_length).normal;
+    return value + std::min({dot(n, a - p), dot(n, b - p), dot(n, c - p)}) >= floor;
+  };
+  return clean(compass_refine(best, best_value, distance, far_enough));
 }
 
 // The radius of the ball about the frame's origin that holds the shape.
@@ -734,8 +753,8 @@ std::optional<double> SolidGeometry::first_contact(const Vec3& a, const Vec3& b,
   return t;
 }
 
-std::array<double, 3> SolidGeometry::deepest_point(const Vec3& a, const Vec3& b,
-                                                   const Vec3& c) const {
+std::array<double, 3> SolidGeometry::deepest_point(const Vec3& a, const Vec3& b, const Vec3& c,
+                                                   double floor) const {
   switch (shape_.kind) {
     case ShapeKind::plane: {
       const std::array<double, 3> height{a.z, b.z, c.z};
@@ -753,7 +772,7 @@ std::array<double, 3> SolidGeometry::deepest_point(const Vec3& a, const Vec3& b,
     case ShapeKind::box:
       return box_deepest(shape_.half_extents, a, b, c);
     case ShapeKind::cylinder:
-      return cylinder_deepest(shape_.radius, shape_.half_length, a, b, c);
+      return cylinder_deepest(shape_.radius, shape_.half_length, a, b, c, floor);
     case ShapeKind::mesh: {
       // Sampled, not exact: a mesh's distance is not convex, so any local search could settle
       // in the wrong valley; a fixed lattice of quarters (the vertices and edge midpoints among

@@ -3,6 +3,7 @@
 // the geometric queries contact detection needs, nothing about time or response.
 
 #include <array>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -112,8 +113,12 @@ class SolidGeometry {
 
   // The point of triangle (a, b, c) with the smallest signed distance to the shape, as
   // barycentric weights (summing to 1, each >= 0): where a solid smaller than a cell, or a
-  // box's edge or corner, presses deepest into it.
-  std::array<double, 3> deepest_point(const Vec3& a, const Vec3& b, const Vec3& c) const;
+  // box's edge or corner, presses deepest into it. A search (the cylinder's) may stop early
+  // once it has proven that no point of the triangle is closer than `floor`, and then returns
+  // a point no closer than that instead of the deepest.
+  std::array<double, 3> deepest_point(
+      const Vec3& a, const Vec3& b, const Vec3& c,
+      double floor = std::numeric_limits<double>::infinity()) const;
 
   // A lower bound of the signed distance over triangle (a, b, c), cheap next to
   // deepest_point: for a box and a cylinder the largest of the distances to the slabs (and the
