@@ -647,6 +647,43 @@ TEST(GeometryTest, DeepestPointBeatsAFineLattice) {
   }
 }
 
+// With a floor, the search may stop once it has proven the triangle no closer than the floor:
+// it then returns a point at least that far, and the lattice agrees that none is closer.
+// Where some point is closer than the floor, the answer is the one without a floor, to the
+// bit. Small triangles over a cylinder's rim, where the cell pass searches (docs/contact.md,
+// "Cost"), with floors just below and above the distance found.
+TEST(GeometryTest, DeepestPointWithAFloorStopsOnlyWhenNoPointIsCloser) {
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> angle(-std::numbers::pi, std::numbers::pi);
+  const SolidGeometry geometry(cylinder(0.4, 0.6));
+  int stopped = 0, searched = 0;
+  for (int i = 0; i < 300; ++i) {
+    const double phi = angle(rng);
+    const Vec3 rim{0.4 * std::cos(phi), 0.4 * std::sin(phi), 0.6};
+    const Vec3 centre = rim + random_vector(rng, 0.01);
+    const Vec3 a = centre + random_vector(rng, 0.03);
+    const Vec3 b = centre + random_vector(rng, 0.03);
+    const Vec3 c = centre + random_vector(rng, 0.03);
+    const auto deepest = geometry.deepest_point(a, b, c);
+    const double found = geometry.closest(at(deepest, a, b, c)).distance;
+    const double lattice = lattice_distance(geometry, a, b, c, 60);
+    for (const double shift : {-1e-3, -1e-6, 1e-6, 1e-3}) {
+      const double floor = found + shift;
+      const auto w = geometry.deepest_point(a, b, c, floor);
+      if (w == deepest) {
+        ++searched;
+        continue;
+      }
+      ++stopped;
+      EXPECT_GE(geometry.closest(at(w, a, b, c)).distance, floor) << "triangle " << i;
+      EXPECT_GE(lattice, floor - 1e-12) << "triangle " << i;
+    }
+  }
+  // Both ways taken (the stops can only be for the floors below the distance found).
+  EXPECT_GT(stopped, 40);
+  EXPECT_GT(searched, 600);
+}
+
 // The triangle's lower bound of the distance never exceeds the distance anywhere on it (a fine
 // lattice, its corners included), for triangles small and large, inside, across and outside
 // the box and the cylinder; and it is the distance itself for a triangle above a face, where
