@@ -1175,7 +1175,8 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
               if (lower >= flat_offset) continue;
             }
             // The deepest point's distance is at least the bound, and the offset below at
-            // most flat_offset (rounded: the slack).
+            // most flat_offset (rounded: the slack); so the search may stop once it proves the
+            // triangle that far.
             if (g.lower_bound(p[0], p[1], p[2]) >= flat_offset + bound_slack) continue;
             const std::array<double, 3> w =
                 g.deepest_point(p[0], p[1], p[2], flat_offset + bound_slack);

@@ -350,7 +350,6 @@ constexpr int kRoundSegments = 32;
 // halved whenever no move lowers the distance. It uses values only (the distance inside a
 // box or a cylinder has kinks where gradients jump) and never raises the distance; on a kink
 // not aligned with any of its six directions it can stop short of the minimum.
-//
 // `far_enough(w, value)` is asked before each step size: when it says yes the search stops
 // where it is.
 template <typename Distance, typename FarEnough>
@@ -358,10 +357,8 @@ Weights compass_refine(Weights w, double value, const Distance& distance,
                        const FarEnough& far_enough) {
   constexpr double kSmallestStep = 1.0 / (1 << 16);
   double step = 0.25;
-  bool asked = false;
+  if (far_enough(w, value)) return w;
   while (step >= kSmallestStep) {
-    if (!asked && far_enough(w, value)) break;
-    asked = true;
     bool moved = false;
     for (int from = 0; from < 3 && !moved; ++from) {
       for (int to = 0; to < 3 && !moved; ++to) {
@@ -380,7 +377,7 @@ Weights compass_refine(Weights w, double value, const Distance& distance,
     }
     if (!moved) {
       step *= 0.5;
-      asked = false;
+      if (step >= kSmallestStep && far_enough(w, value)) break;
     }
   }
   return w;
