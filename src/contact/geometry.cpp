@@ -343,6 +343,12 @@ TriangleMesh box_surface(const Vec3& half) {
 }
 
 constexpr int kRoundSegments = 32;
+// circle_nearest: Newton's method converges quadratically, and an angle settled to 1e-13 puts
+// the circle's point within 1e-13 R of its place; the answer is then certified (below) to
+// within 1e-12 of the cylinder's size.
+constexpr int kCircleIterations = 40;
+constexpr double kCircleAngleTolerance = 1e-13;
+constexpr double kCircleCertified = 1e-12;
 
 // ---- deepest_point for each shape --------------------------------------------------------
 
@@ -540,10 +546,57 @@ Weights cylinder_pressed(double radius, double half_length, const Vec3& a, const
   return clean(best);
 }
 
+// The triangle's point nearest the circle ρ = R at height z, from the circle's angle θ: with
+// q(θ) the circle's point and p(θ) the triangle's point nearest it, the pair is nearest where
+// q − p is normal to the circle, s(θ) = (q − p)·t̂ = 0 (t̂ the circle's tangent, r̂ its outward
+// normal). Newton's method on θ, with s′ = R (1 − t̂·J t̂) − (q − p)·r̂, J the derivative of the
+// nearest point: the projection on the triangle's plane inside it, on an edge's line on an
+// edge, zero at a corner. Nothing when s′ is not positive (p then lies within the circle's
+// radius, nearer the cap than the rim) or when it has not settled.
+std::optional<Weights> circle_nearest(double radius, double z, double theta, const Vec3& a,
+                                      const Vec3& b, const Vec3& c) {
+  const std::array<const Vec3*, 3> corner{&a, &b, &c};
+  const Vec3 normal = cross(b - a, c - a);
+  const double area2 = dot(normal, normal);
+  double below = -kInfinity, above = kInfinity;  // angles where s < 0 and where s >= 0
+  for (int iteration = 0; iteration < kCircleIterations; ++iteration) {
+    const double cosine = std::cos(theta), sine = std::sin(theta);
+    const Vec3 q{radius * cosine, radius * sine, z};
+    const Vec3 tangent{-sine, cosine, 0.0}, outward{cosine, sine, 0.0};
+    const Weights w = closest_on_triangle(q, a, b, c);
+    const Vec3 d = q - at(w, a, b, c);
+    double along = 0.0;
+    const int zeros = (w[0] == 0.0) + (w[1] == 0.0) + (w[2] == 0.0);
+    if (zeros == 0) {
+      const double across = dot(normal, tangent);
+      along = 1.0 - across * across / area2;
+    } else if (zeros == 1) {
+      const int skip = w[0] == 0.0 ? 0 : (w[1] == 0.0 ? 1 : 2);
+      const Vec3 edge = *corner[(skip + 2) % 3] - *corner[(skip + 1) % 3];
+      const double length2 = dot(edge, edge);
+      const double component = dot(edge, tangent);
+      if (length2 > 0.0) along = component * component / length2;
+    }
+    const double rate = radius * (1.0 - along) - dot(d, outward);
+    if (!(rate > 0.0)) return std::nullopt;
+    const double slope = dot(d, tangent);
+    (slope < 0.0 ? below : above) = theta;
+    const double step = slope / rate;
+    if (std::abs(step) <= kCircleAngleTolerance || above - below <= kCircleAngleTolerance)
+      return w;
+    theta -= step;
+    // s is smooth only between the points where p(θ) changes feature: where Newton's step
+    // leaves the angles known to bracket the root, halve them instead.
+    if (!(theta > below && theta < above)) theta = 0.5 * (below + above);
+  }
+  return std::nullopt;
+}
+
 // The cylinder's distance has a curved kink where side and cap meet, so no finite candidate
-// set is exact. Pressed into the cylinder the bisection above is; apart from it the distance
-// is round at the rims, so candidates (the triangle's corners, its points nearest the centre,
-// the axis and rim samples) and a compass search from the best cover that.
+// set is exact. Beside the side it is in closed form, and nearest a rim from outside
+// circle_nearest finds it, certified by the convexity bound. Pressed into the cylinder the
+// bisection above is exact; elsewhere candidates (the triangle's corners, its points nearest
+// the centre, the axis and rim samples) and a compass search from the best cover it.
 Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const Vec3& b,
                          const Vec3& c, double floor) {
   // Beside the side, away from the caps, the distance is ρ − R, ρ the distance from the axis:
@@ -558,6 +611,32 @@ Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const
     const Vec3 fa{a.x, a.y, 0.0}, fb{b.x, b.y, 0.0}, fc{c.x, c.y, 0.0};
     const Weights w = closest_on_triangle({0.0, 0.0, 0.0}, fa, fb, fc);
     if (norm(at(w, fa, fb, fc)) - radius >= top - half_length) return clean(w);
+  }
+  // The signed distance to a convex solid is convex, so over the triangle it is at least its
+  // value at any point p plus the least reach of its normal n there towards the corners.
+  const auto bound_at = [&](const Vec3& p, double value, const Vec3& n) {
+    return value + std::min({dot(n, a - p), dot(n, b - p), dot(n, c - p)});
+  };
+  // Apart from the cylinder and nearest a rim, the deepest point is the triangle's point
+  // nearest the rim's circle; the bound at it is its distance when its nearest point of the
+  // cylinder is on that rim (the triangle then lies beyond the plane through it normal to
+  // q − p), which certifies it. The rim of the triangle's middle's side, from the middle's
+  // angle.
+  const Vec3 centroid = (a + b + c) / 3.0;
+  if (centroid.x != 0.0 || centroid.y != 0.0) {
+    const std::optional<Weights> w =
+        circle_nearest(radius, centroid.z >= 0.0 ? half_length : -half_length,
+                       std::atan2(centroid.y, centroid.x), a, b, c);
+    if (w) {
+      const Weights found = clean(*w);
+      const Vec3 p = at(found, a, b, c);
+      const Closest near = cylinder_closest(p, radius, half_length);
+      if (near.distance > 0.0) {
+        const double bound = bound_at(p, near.distance, near.normal);
+        if (bound >= floor || near.distance - bound <= kCircleCertified * (radius + half_length))
+          return found;
+      }
+    }
   }
   // 6 fixed candidates and the 2 x 16 rim samples.
   FixedList<Weights, 38> candidates{
@@ -623,14 +702,12 @@ Weights cylinder_deepest(double radius, double half_length, const Vec3& a, const
       best = pressed;
     }
   }
-  // The signed distance to a convex solid is convex, so over the triangle it is at least its
-  // value at any point w plus the least reach of its normal there towards the corners: once
-  // that is `floor`, no point of the triangle comes closer and the search may stop.
+  // Else the compass search, which stops once the bound at its best point proves that no
+  // point of the triangle comes closer than `floor`.
   const auto far_enough = [&](const Weights& w, double value) {
     if (value < floor) return false;
     const Vec3 p = at(w, a, b, c);
-    const Vec3 n = cylinder_closest(p, radius, half_length).normal;
-    return value + std::min({dot(n, a - p), dot(n, b - p), dot(n, c - p)}) >= floor;
+    return bound_at(p, value, cylinder_closest(p, radius, half_length).normal) >= floor;
   };
   return clean(compass_refine(best, best_value, distance, far_enough));
 }
