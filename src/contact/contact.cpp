@@ -916,7 +916,15 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
               normal = at_end.normal;
               target = end + (offset - at_end.distance) * normal;
             } else {
-              // Both ends outside: only a segment crossing the solid can touch it.
+              // Both ends outside: only a segment crossing the solid can touch it. The distance
+              // is 1-Lipschitz, so a path shorter than the end's clearance stays out, with
+              // first_contact's tolerance to spare (a mesh's search can end on its iteration
+              // limit instead, so it is always asked).
+              const double length = norm(path);
+              if (s.spec.shape.kind != ShapeKind::mesh &&
+                  at_end.distance - length >
+                      offset + SolidGeometry::kContactTolerance * std::max(length, offset))
+                continue;
               if (g.closest(start).distance < offset) continue;  // leaving, not entering
               const std::optional<double> t = g.first_contact(start, end, offset);
               if (!t) continue;

@@ -799,11 +799,9 @@ Closest SolidGeometry::closest_other(const Vec3& p) const {
 std::optional<double> SolidGeometry::first_contact(const Vec3& a, const Vec3& b,
                                                    double offset) const {
   constexpr int kMaxIterations = 200;
-  // Contact within a relative 1e-7 of the step's scales: far below any response's own error,
-  // and reached in a few Newton steps.
   const Vec3 d = b - a;
   const double length = norm(d);
-  const double tolerance = 1e-7 * std::max(length, offset);
+  const double tolerance = kContactTolerance * std::max(length, offset);
   Closest nearest = closest(a);
   double gap = nearest.distance - offset;
   if (gap <= tolerance) return 0.0;

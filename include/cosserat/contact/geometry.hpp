@@ -108,7 +108,10 @@ class SolidGeometry {
   }
 
   // Continuous detection (CONTACT.md §2): the smallest t in [0, 1] at which a + t (b − a)
-  // is within `offset` of the shape (t = 0 when a already is), or nothing.
+  // is within `offset` of the shape (t = 0 when a already is), or nothing. "Within" to
+  // kContactTolerance times the larger of |b − a| and the offset: far below any response's
+  // own error, and reached in a few Newton steps.
+  static constexpr double kContactTolerance = 1e-7;
   std::optional<double> first_contact(const Vec3& a, const Vec3& b, double offset) const;
 
   // The point of triangle (a, b, c) with the smallest signed distance to the shape, as
