@@ -1154,6 +1154,25 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
                        std::min(distance_(kc, lc + 1), distance_(kc + 1, lc + 1)));
           const double cell_longest = *std::max_element(edge.begin(), edge.end());
           if (cell_nearest - cell_longest >= flat_offset) continue;
+          // The tangent-plane bound below, for the whole cell first: each node's over all
+          // four nodes is at most its own over any triangle of them, and every triangle holds
+          // one of the two nodes with the largest, so the second largest bounds them all. A
+          // cell resting on a face is done here, not four times.
+          if (convex) {
+            std::array<double, 4> bound{};
+            for (int v = 0; v < 4; ++v) {
+              const int kv = kc + (v & 1), lv = lc + (v >> 1);
+              const Vec3 n = normal_(kv, lv);
+              bound[static_cast<std::size_t>(v)] = -1e300;
+              if (dot(n, n) == 0.0) continue;
+              double reach = 0.0;
+              for (int q = 0; q < 4; ++q)
+                reach = std::min(reach, dot(n, local_(kc + (q & 1), lc + (q >> 1)) - local_(kv, lv)));
+              bound[static_cast<std::size_t>(v)] = distance_(kv, lv) + reach;
+            }
+            std::sort(bound.begin(), bound.end());
+            if (bound[2] >= flat_offset) continue;
+          }
           for (int tri = 0; tri < kCellTriangles; ++tri) {
             const TriangleCorners nodes = triangle_corners(kc, lc, tri);
             double nearest = 1e300, longest = 0.0;
