@@ -1257,12 +1257,22 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   for (const auto& row : push_rows_) cells_.insert(cells_.end(), row.begin(), row.end());
   if (cells_.empty()) return;
   for (std::size_t i = 0; i < cells_.size(); ++i) slot_[cells_[i].triangle] = static_cast<int>(i);
+  // The tiles holding a pushed triangle's owned nodes: only their nodes can have a push to sum.
+  pushed_.assign(cells_near_.size(), 0);
+  for (const CellPush& push : cells_) {
+    const auto cell = static_cast<int>(push.triangle / kCellTriangles);
+    const int kc = cell % width + b.k0 - 1, lc = cell / width + b.l0 - 1;
+    for (int v = 0; v < 4; ++v) {
+      const int k = kc + (v & 1), l = lc + (v >> 1);
+      if (b.owns(k, l)) pushed_[tile((k - b.k0) / kTile, (l - b.l0) / kTile)] = 1;
+    }
+  }
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j) {
     std::vector<Exchange>& exchanges = exchange_rows_[static_cast<std::size_t>(j)];
     exchanges.clear();
     for (int i = 0; i < tiles_k_; ++i) {
-      if (!near_node_tile(i, j)) continue;
+      if (!pushed_[tile(i, j)]) continue;
       const TileRange range = tile_nodes(i, j);
       bool grew = false;
       for (int l = range.l0; l < range.l1; ++l)

@@ -266,6 +266,7 @@ class Contact {
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
   std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
+  std::vector<unsigned char> pushed_;        // cell_pass: per tile, a triangle pushes its nodes
   std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
   const Field<Vec3>* next_velocities_ = nullptr;  // of the step being proposed, or null
   std::vector<std::vector<Exchange>> exchange_rows_;  // per tile row, reused step to step
