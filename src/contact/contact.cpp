@@ -1166,8 +1166,10 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
               bound[static_cast<std::size_t>(v)] = -1e300;
               if (dot(n, n) == 0.0) continue;
               double reach = 0.0;
-              for (int q = 0; q < 4; ++q)
-                reach = std::min(reach, dot(n, local_(kc + (q & 1), lc + (q >> 1)) - local_(kv, lv)));
+              for (int q = 0; q < 4; ++q) {
+                const Vec3& p = local_(kc + (q & 1), lc + (q >> 1));
+                reach = std::min(reach, dot(n, p - local_(kv, lv)));
+              }
               bound[static_cast<std::size_t>(v)] = distance_(kv, lv) + reach;
             }
             std::sort(bound.begin(), bound.end());
