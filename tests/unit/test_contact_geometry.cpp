@@ -648,9 +648,9 @@ TEST(GeometryTest, DeepestPointBeatsAFineLattice) {
 }
 
 // The smallest signed distance over triangle (a, b, c) by a lattice zoomed in on its best
-// point: the distance is convex, so its minimum lies within a cell of the best lattice point;
-// eight zooms by 5 put it within ~1e-7 of the triangle's size, which moves a smooth minimum
-// by far less than 1e-12.
+// point: each level takes the cells around the best point so far, 20 times smaller, eight
+// times. A distance at a point of the triangle, so never below the smallest; on a smooth
+// minimum within far less than 1e-12 of it.
 double zoomed_distance(const SolidGeometry& geometry, const Vec3& a, const Vec3& b, const Vec3& c) {
   double u0 = 0.0, v0 = 0.0, width = 1.0, best = std::numeric_limits<double>::infinity();
   constexpr int kDivisions = 40;
