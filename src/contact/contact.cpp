@@ -1124,6 +1124,18 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           }
         }
     }
+  // The signed distance to a convex solid lies above its tangent plane at each node, so over
+  // any triangle of `points` holding node (k, l) it is at least d + min_j n·(p_j − p), or −∞
+  // for a node without a normal (outside the solid's ball): a cell resting on a face, all its
+  // nodes on the offset surface, is not tested further.
+  const auto tangent_bound = [&](int k, int l, const auto& points) {
+    const Vec3 n = normal_(k, l);
+    if (dot(n, n) == 0.0) return -1e300;
+    const Vec3& here = local_(k, l);
+    double reach = 0.0;
+    for (const Vec3& q : points) reach = std::min(reach, dot(n, q - here));
+    return distance_(k, l) + reach;
+  };
   const int width = b.owned_k() + 1;
   const auto triangle = [&](int kc, int lc, int tri) {
     return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width) * kCellTriangles +
@@ -1159,18 +1171,12 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           // one of the two nodes with the largest, so the second largest bounds them all. A
           // cell resting on a face is done here, not four times.
           if (convex) {
+            const std::array<Vec3, 4> corners{local_(kc, lc), local_(kc + 1, lc),
+                                              local_(kc, lc + 1), local_(kc + 1, lc + 1)};
             std::array<double, 4> bound{};
             for (int v = 0; v < 4; ++v) {
-              const int kv = kc + (v & 1), lv = lc + (v >> 1);
-              const Vec3 n = normal_(kv, lv);
-              bound[static_cast<std::size_t>(v)] = -1e300;
-              if (dot(n, n) == 0.0) continue;
-              double reach = 0.0;
-              for (int q = 0; q < 4; ++q) {
-                const Vec3& p = local_(kc + (q & 1), lc + (q >> 1));
-                reach = std::min(reach, dot(n, p - local_(kv, lv)));
-              }
-              bound[static_cast<std::size_t>(v)] = distance_(kv, lv) + reach;
+              const auto at = static_cast<std::size_t>(v);
+              bound[at] = tangent_bound(kc + (v & 1), lc + (v >> 1), corners);
             }
             std::sort(bound.begin(), bound.end());
             if (bound[2] >= flat_offset) continue;
@@ -1188,19 +1194,10 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
             std::array<Vec3, 3> p;
             for (int v = 0; v < 3; ++v)
               p[v] = local_(nodes[v][0], nodes[v][1]);
-            // The signed distance to a convex solid lies above its tangent plane at each node,
-            // so over the triangle it is at least d_v + min_j n_v·(p_j − p_v) for every node v:
-            // a cell resting on a face, all its nodes on the offset surface, is not tested
-            // further.
             if (convex) {
               double lower = -1e300;
-              for (int v = 0; v < 3; ++v) {
-                const Vec3 n = normal_(nodes[v][0], nodes[v][1]);
-                if (dot(n, n) == 0.0) continue;
-                double reach = 0.0;
-                for (int q = 0; q < 3; ++q) reach = std::min(reach, dot(n, p[q] - p[v]));
-                lower = std::max(lower, distance_(nodes[v][0], nodes[v][1]) + reach);
-              }
+              for (int v = 0; v < 3; ++v)
+                lower = std::max(lower, tangent_bound(nodes[v][0], nodes[v][1], p));
               if (lower >= flat_offset) continue;
             }
             // The deepest point's distance is at least the bound, and the offset below at
