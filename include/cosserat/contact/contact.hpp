@@ -266,6 +266,22 @@ class Contact {
   std::vector<double> spare_;                // per tile: how far a node can move and not
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
   std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
+  std::vector<unsigned char> cells_live_;    // and one of them is not known to be clear
+  std::vector<unsigned char> live_cells_;    // cell_pass: per cell of a live tile, likewise
+  // A fixed solid's cells found clear (docs/contact.md, "Cost"): per solid (empty for the
+  // others) and cell of owned nodes, the bound of its distance
+  // found then, plus `since` of its tiles then (travelled_tile), or −∞. Per tile, the sum of
+  // its box's largest moves over the accepted steps. A response not followed by accept() (a
+  // step that failed), or a restore(), forgets them.
+  std::vector<std::vector<double>> clear_;
+  std::vector<std::vector<double>> node_clear_;  // and per owned node, its end's distance
+  std::vector<double> travel_;
+  bool unaccepted_ = false;
+  void forget_clear();
+  struct Travel {
+    double since, until;
+  };
+  Travel travelled_tile(std::size_t t) const;
   std::vector<unsigned char> pushed_;        // cell_pass: per tile, a triangle pushes its nodes
   std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
   const Field<Vec3>* next_velocities_ = nullptr;  // of the step being proposed, or null
