@@ -241,14 +241,6 @@ TEST(DecompositionInvariance, AnUnstableRunStopsAtTheSameStepAndNodeOnEverySplit
   }
 }
 
-// An observer of nothing: the adaptive step loop's choices alone are compared.
-class Silent : public StepObserver {
- public:
-  void frame() override {}
-  void checkpoint(const LoopCarry&) override {}
-  void progress(long) override {}
-};
-
 // Adaptive steps choose each step from global maxima: the same steps, the same roll-back and the
 // same trajectory, bitwise, on every split, for a scheme of each state kind; in gusts too, read
 // at the times of steps of every size.
@@ -258,7 +250,7 @@ TEST(DecompositionInvariance, AdaptiveStepsAndTheirRollBacksFollowTheOneBlockRun
                                testing::gusty_rolling_back_scene(integrator)}) {
       const std::string what = integrator_name(integrator) + (scene.fluid ? " in gusts" : "");
       Simulation reference(scene, MPI_COMM_SELF, any_scheme);
-      Silent silent;
+      testing::Silent silent;
       const StepLoopResult expected = run_step_loop(reference, scene, {}, silent);
       ASSERT_FALSE(expected.failure) << what;
       ASSERT_TRUE(expected.adaptive);

@@ -15,13 +15,6 @@
 namespace cosserat {
 namespace {
 
-class Silent : public StepObserver {
- public:
-  void frame() override {}
-  void checkpoint(const LoopCarry&) override {}
-  void progress(long) override {}
-};
-
 struct ContactScene {
   std::string file;
   std::string duration;  // seconds simulated: past the solids' first contacts
@@ -36,7 +29,7 @@ TEST_P(ContactScenes, NoNodeIsLeftInsideASolid) {
   const Scene scene = load_scene(std::string(COSSERAT_SOURCE_DIR) + "/scenes/contact/" + c.file,
                                  {"time.duration=" + c.duration});
   Simulation sim(scene, MPI_COMM_SELF);
-  Silent silent;
+  testing::Silent silent;
   const StepLoopResult result = run_step_loop(sim, scene, {}, silent);
   ASSERT_FALSE(result.failure) << c.file;
   const ContactSummary summary = sim.contact_summary();
@@ -54,7 +47,7 @@ TEST(ContactScenes, AThinRodCarriesThePinnedSheet) {
   const Scene scene =
       load_scene(std::string(COSSERAT_SOURCE_DIR) + "/scenes/contact/rod_through_sheet.toml");
   Simulation sim(scene, MPI_COMM_SELF);
-  Silent silent;
+  testing::Silent silent;
   ASSERT_FALSE(run_step_loop(sim, scene, {}, silent).failure);
   const SolidState& rod = sim.contact()->state(0);
   const double tip = rod.pose.position.y + scene.solids[0].shape.half_length +

@@ -9,8 +9,17 @@
 
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/simulation.hpp"
+#include "cosserat/time/step_loop.hpp"
 
 namespace cosserat::testing {
+
+// An observer of nothing: a step loop's own choices alone.
+class Silent : public StepObserver {
+ public:
+  void frame() override {}
+  void checkpoint(const LoopCarry&) override {}
+  void progress(long) override {}
+};
 
 // m x n sheet, 10 m x 10 m in the xz plane, SCENES.md default material, no terms at all.
 inline Scene flat_sheet(int m, int n) {

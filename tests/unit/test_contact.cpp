@@ -17,7 +17,6 @@
 #include "cosserat/contact/contact.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/halo.hpp"
-#include "cosserat/time/step_loop.hpp"
 #include "support/sheets.hpp"
 
 namespace cosserat {
@@ -544,13 +543,6 @@ thickness = 0.005
 )";
 }
 
-class NoObserver : public StepObserver {
- public:
-  void frame() override {}
-  void checkpoint(const LoopCarry&) override {}
-  void progress(long) override {}
-};
-
 // The response skips a fixed solid's cells and nodes it found clear while the cloth has not
 // moved far enough since to reach it (docs/contact.md, "Cost"). That skips only what the tests
 // would skip, so the run is bitwise the one against the same solids made kinematic but never
@@ -565,9 +557,9 @@ TEST(Contact, AFixedSolidsRememberedClearancesChangeNoStep) {
     const Scene fixed = parse_scene(table_scene("", time), "fixed.toml");
     const Scene moving = parse_scene(table_scene(still, time), "still.toml");
     Simulation a(fixed, MPI_COMM_SELF), b(moving, MPI_COMM_SELF);
-    NoObserver none;
-    const StepLoopResult ra = run_step_loop(a, fixed, {}, none);
-    const StepLoopResult rb = run_step_loop(b, moving, {}, none);
+    testing::Silent silent;
+    const StepLoopResult ra = run_step_loop(a, fixed, {}, silent);
+    const StepLoopResult rb = run_step_loop(b, moving, {}, silent);
     ASSERT_FALSE(ra.failure) << ra.failure->diagnosis;
     ASSERT_FALSE(rb.failure);
     if (ra.adaptive) {
