@@ -276,6 +276,8 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     tile_touched_.resize(tiles);
     cells_near_.resize(tiles);
     cells_live_.resize(tiles);
+    reach_.resize(tiles);
+    live_cells_.assign(static_cast<std::size_t>(block.owned_k() + 3) * (block.owned_l() + 3), 0);
     travel_.resize(tiles);
     clear_.resize(solids.size());
     node_clear_.resize(solids.size());
@@ -839,9 +841,19 @@ void Contact::grow_box(std::size_t t, int k, int l, const Field<Vec3>& current,
 // most travel_[t] − travel_then from where it began a step that ended with travel_then, and
 // a bound D of its distance found then, less that step's move to then, bounds it from there.
 // So D − until + since bounds it now, with since and until these, for any solid that stays
-// put (clear_, node_clear_).
+// put (node_clear_). travel_ sums the largest move of the tile and the tiles after it, which
+// hold the nodes of its cells, so a cell's nodes are bound the same way with that move for
+// boxes_[t].moved (reach_, clear_).
 Contact::Travel Contact::travelled_tile(std::size_t t) const {
   return {travel_[t] - boxes_[t].moved, travel_[t] + boxes_[t].moved};
+}
+
+double Contact::cell_reach_move(int i, int j) const {
+  double moved = 0.0;
+  for (int dj = 0; dj < 2 && j + dj < tiles_l_; ++dj)
+    for (int di = 0; di < 2 && i + di < tiles_k_; ++di)
+      moved = std::max(moved, boxes_[tile(i + di, j + dj)].moved);
+  return moved;
 }
 
 // A tile's velocities before the response moves any of its nodes. After a walk, the nodes it
@@ -1096,7 +1108,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const double bound_slack = kBroadSlack * (radius + thickness);
   const bool remembers = pass == 0 && s.spec.motion == SolidMotion::fixed;
   std::vector<double>& clear = clear_[solid];
-  const std::size_t clear_size = static_cast<std::size_t>(b.owned_k() + 1) * (b.owned_l() + 1);
   halo_->exchange(next);
   halo_->exchange(velocity_);
   // The broad phase: a tile's cells are visited only when the box of their nodes (the tile's
@@ -1133,11 +1144,17 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           c.k1 > c.k0 && c.l1 > c.l0 &&
           box_gap(centre, centre, lo, hi) - radius < flat_offset + slack &&
           box_gap(lo, hi, s.reach_lo, s.reach_hi) < flat_offset + slack;
+      // The nodes of a tile's own cells are in it and the tiles after it (travelled_tile).
+      if (remembers) {
+        const std::size_t t = tile(i, j);
+        const double moved = cell_reach_move(i, j);
+        reach_[t] = {travel_[t] - moved, travel_[t] + moved};
+      }
     }
   // A cell of owned nodes found clear by a distance D (any lower bound of its triangles'
   // signed distances: the tests below) stays clear while its nodes have moved less than
   // D − flat_offset since, since the distance is 1-Lipschitz and each point of a triangle
-  // moves at most as far as its corners; its nodes' tiles bound that move (travelled).
+  // moves at most as far as its corners; its nodes' tiles bound that move (reach_).
   const auto owned_cell = [&](int kc, int lc) {
     return kc >= b.k0 && lc >= b.l0 && kc + 1 < b.k1 && lc + 1 < b.l1;
   };
@@ -1145,46 +1162,31 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const auto cell_index = [&](int kc, int lc) {
     return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width);
   };
-  const auto travelled = [&](int kc, int lc) {
-    const int i0 = (kc - b.k0) / kTile, i1 = (kc + 1 - b.k0) / kTile;
-    const int j0 = (lc - b.l0) / kTile, j1 = (lc + 1 - b.l0) / kTile;
-    Travel most{kHuge, 0.0};
-    for (int j = j0; j <= j1; ++j)
-      for (int i = i0; i <= i1; ++i) {
-        const Travel here = travelled_tile(tile(i, j));
-        most = {std::min(most.since, here.since), std::max(most.until, here.until)};
-      }
-    return most;
-  };
-  const auto known_clear = [&](int kc, int lc) {
+  const auto known_clear = [&](int kc, int lc, std::size_t t) {
     return remembers && owned_cell(kc, lc) &&
-           clear[cell_index(kc, lc)] - travelled(kc, lc).until >= flat_offset + bound_slack;
+           clear[cell_index(kc, lc)] - reach_[t].until >= flat_offset + bound_slack;
   };
-  // The cells to visit: those of the tiles near the solid not known to be clear.
-  if (live_cells_.size() != clear_size) live_cells_.assign(clear_size, 0);
+  // The cells to visit: those of the tiles near the solid not known to be clear, flagged in
+  // live_cells_, whose cells of a tile not live are all 0, and those of no tile always.
+  const int flag_width = b.owned_k() + 3;
+  const auto flag = [&](int kc, int lc) {
+    return static_cast<std::size_t>(kc - b.k0 + 2 + (lc - b.l0 + 2) * flag_width);
+  };
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
       const std::size_t t = tile(i, j);
+      if (!cells_near_[t] && !cells_live_[t]) continue;
       bool live = false;
-      if (cells_near_[t]) {
-        const TileRange cells = tile_cell_nodes(i, j);
-        for (int lc = cells.l0; lc < cells.l1; ++lc)
-          for (int kc = cells.k0; kc < cells.k1; ++kc) {
-            const bool needed = !known_clear(kc, lc);
-            live_cells_[cell_index(kc, lc)] = needed ? 1 : 0;
-            live = live || needed;
-          }
-      }
+      const TileRange cells = tile_cell_nodes(i, j);
+      for (int lc = cells.l0; lc < cells.l1; ++lc)
+        for (int kc = cells.k0; kc < cells.k1; ++kc) {
+          const bool needed = cells_near_[t] && !known_clear(kc, lc, t);
+          live_cells_[flag(kc, lc)] = needed ? 1 : 0;
+          live = live || needed;
+        }
       cells_live_[t] = live ? 1 : 0;
     }
-  const int first_kc = std::max(b.k0 - 1, 0), end_kc = std::min(b.k1, b.m - 1);
-  const int first_lc = std::max(b.l0 - 1, 0), end_lc = std::min(b.l1, b.n - 1);
-  const auto live_cell = [&](int kc, int lc) {
-    if (kc < first_kc || kc >= end_kc || lc < first_lc || lc >= end_lc) return false;
-    const std::size_t t = tile(std::max(kc - b.k0, 0) / kTile, std::max(lc - b.l0, 0) / kTile);
-    return cells_live_[t] && live_cells_[cell_index(kc, lc)];
-  };
   // Whether a tile's nodes belong to a visited cell: its own cells, or those of the tiles
   // before it; and a node's.
   const auto near_node_tile = [&](int i, int j) {
@@ -1194,8 +1196,8 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
     return false;
   };
   const auto live_node = [&](int k, int l) {
-    return live_cell(k - 1, l - 1) || live_cell(k, l - 1) || live_cell(k - 1, l) ||
-           live_cell(k, l);
+    const unsigned char* around = &live_cells_[flag(k - 1, l - 1)];
+    return (around[0] | around[1] | around[flag_width] | around[flag_width + 1]) != 0;
   };
   // A lower bound of each node's signed distance: the distance itself near the solid, the
   // distance to its bounding ball farther out. The distance is 1-Lipschitz, so a triangle
@@ -1364,10 +1366,10 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       const TileRange cells = tile_cell_nodes(i, j);
       for (int lc = cells.l0; lc < cells.l1; ++lc)
         for (int kc = cells.k0; kc < cells.k1; ++kc) {
-          if (!live_cells_[cell_index(kc, lc)]) continue;
+          if (!live_cells_[flag(kc, lc)]) continue;
           const double found = visit(kc, lc, pushes);
           if (remembers && owned_cell(kc, lc))
-            clear[cell_index(kc, lc)] = found + travelled(kc, lc).since;
+            clear[cell_index(kc, lc)] = found + reach_[tile(i, j)].since;
         }
     }
   }
@@ -1704,7 +1706,8 @@ void Contact::accept() {
     s.state = s.proposed;
     s.pushing = s.proposed_pushing;
   }
-  for (std::size_t t = 0; t < boxes_.size(); ++t) travel_[t] += boxes_[t].moved;
+  for (int j = 0; j < tiles_l_; ++j)
+    for (int i = 0; i < tiles_k_; ++i) travel_[tile(i, j)] += cell_reach_move(i, j);
   unaccepted_ = false;
 }
 

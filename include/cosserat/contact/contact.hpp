@@ -267,11 +267,11 @@ class Contact {
   std::vector<unsigned char> tile_touched_;  // per tile: the response moved one of its nodes
   std::vector<unsigned char> cells_near_;    // cell_pass: per tile, its cells may meet the solid
   std::vector<unsigned char> cells_live_;    // and one of them is not known to be clear
-  std::vector<unsigned char> live_cells_;    // cell_pass: per cell of a live tile, likewise
+  std::vector<unsigned char> live_cells_;    // cell_pass: per cell, likewise (see there)
   // A fixed solid's cells found clear (docs/contact.md, "Cost"): per solid (empty for the
-  // others) and cell of owned nodes, the bound of its distance
-  // found then, plus `since` of its tiles then (travelled_tile), or −∞. Per tile, the sum of
-  // its box's largest moves over the accepted steps. A response not followed by accept() (a
+  // others) and cell of owned nodes, the bound of its distance found then, plus `since` of its
+  // tile then (travelled_tile), or −∞. Per tile, the sum over the accepted steps of the
+  // largest move of its nodes and of the next tiles'. A response not followed by accept() (a
   // step that failed), or a restore(), forgets them.
   std::vector<std::vector<double>> clear_;
   std::vector<std::vector<double>> node_clear_;  // and per owned node, its end's distance
@@ -282,6 +282,8 @@ class Contact {
     double since, until;
   };
   Travel travelled_tile(std::size_t t) const;
+  double cell_reach_move(int i, int j) const;  // the largest move of tile (i, j) and the next
+  std::vector<Travel> reach_;  // cell_pass: per tile, travelled_tile for its cells' nodes
   std::vector<unsigned char> pushed_;        // cell_pass: per tile, a triangle pushes its nodes
   std::vector<unsigned char> ready_;         // per tile: prepare() has set its velocities
   const Field<Vec3>* next_velocities_ = nullptr;  // of the step being proposed, or null
