@@ -284,8 +284,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     for (std::size_t i = 0; i < solids.size(); ++i) {
       const SolidSpec& spec = solids[i];
       if (spec.motion != SolidMotion::fixed || spec.shape.kind == ShapeKind::plane) continue;
-      clear_[i].assign(static_cast<std::size_t>(block.owned_k() + 1) * (block.owned_l() + 1),
-                       -kHuge);
+      clear_[i].assign(live_cells_.size(), -kHuge);
       if (spec.shape.kind != ShapeKind::mesh)
         node_clear_[i].assign(static_cast<std::size_t>(block.owned_k()) * block.owned_l(),
                               -kHuge);
@@ -893,13 +892,6 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
                         std::vector<Exchange>& out) {
   const std::size_t first = walked_ && pass == 0 ? planes_ : 0;
   const Block& b = *block_;
-  // A node found clear of a fixed solid stays so while it moves less than its margin
-  // (travelled_tile): a path no longer than its tile's move, ending that much farther than the
-  // offset, meets nothing (the test on both ends outside, below).
-  const auto remembers = [&](const Solid& s) {
-    return pass == 0 && s.spec.motion == SolidMotion::fixed &&
-           s.spec.shape.kind != ShapeKind::mesh && s.spec.shape.kind != ShapeKind::plane;
-  };
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j) {
     std::vector<Exchange>& row = exchange_rows_[static_cast<std::size_t>(j)];
@@ -937,7 +929,11 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
               grow_box(here, k, l, current, next);
               continue;
             }
-            const bool remembered = remembers(s);
+            // A node found clear of a fixed solid (node_clear_) stays so while it moves less
+            // than its margin (travelled_tile): a path no longer than its tile's move, ending
+            // that much farther than the offset, meets nothing (the test on both ends outside,
+            // below).
+            const bool remembered = pass == 0 && !node_clear_[i].empty();
             const std::size_t at = static_cast<std::size_t>(k - b.k0) +
                                    static_cast<std::size_t>(l - b.l0) * b.owned_k();
             if (remembered) {
@@ -1106,7 +1102,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const double radius = g.bounding_radius();
   const bool convex = s.spec.shape.kind != ShapeKind::mesh;
   const double bound_slack = kBroadSlack * (radius + thickness);
-  const bool remembers = pass == 0 && s.spec.motion == SolidMotion::fixed;
+  const bool remembers = pass == 0 && !clear_[solid].empty();
   std::vector<double>& clear = clear_[solid];
   halo_->exchange(next);
   halo_->exchange(velocity_);
@@ -1158,9 +1154,11 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const auto owned_cell = [&](int kc, int lc) {
     return kc >= b.k0 && lc >= b.l0 && kc + 1 < b.k1 && lc + 1 < b.l1;
   };
-  const int width = b.owned_k() + 1;
+  // Cells from kc = k0 − 2 on (a ghost node's cells, and one beyond), in rows of `width`:
+  // clear_, live_cells_ and slot_ (per triangle) by the same index.
+  const int width = b.owned_k() + 3;
   const auto cell_index = [&](int kc, int lc) {
-    return static_cast<std::size_t>(kc - b.k0 + 1 + (lc - b.l0 + 1) * width);
+    return static_cast<std::size_t>(kc - b.k0 + 2 + (lc - b.l0 + 2) * width);
   };
   const auto known_clear = [&](int kc, int lc, std::size_t t) {
     return remembers && owned_cell(kc, lc) &&
@@ -1168,10 +1166,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   };
   // The cells to visit: those of the tiles near the solid not known to be clear, flagged in
   // live_cells_, whose cells of a tile not live are all 0, and those of no tile always.
-  const int flag_width = b.owned_k() + 3;
-  const auto flag = [&](int kc, int lc) {
-    return static_cast<std::size_t>(kc - b.k0 + 2 + (lc - b.l0 + 2) * flag_width);
-  };
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j)
     for (int i = 0; i < tiles_k_; ++i) {
@@ -1182,7 +1176,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       for (int lc = cells.l0; lc < cells.l1; ++lc)
         for (int kc = cells.k0; kc < cells.k1; ++kc) {
           const bool needed = cells_near_[t] && !known_clear(kc, lc, t);
-          live_cells_[flag(kc, lc)] = needed ? 1 : 0;
+          live_cells_[cell_index(kc, lc)] = needed ? 1 : 0;
           live = live || needed;
         }
       cells_live_[t] = live ? 1 : 0;
@@ -1196,8 +1190,8 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
     return false;
   };
   const auto live_node = [&](int k, int l) {
-    const unsigned char* around = &live_cells_[flag(k - 1, l - 1)];
-    return (around[0] | around[1] | around[flag_width] | around[flag_width + 1]) != 0;
+    const unsigned char* around = &live_cells_[cell_index(k - 1, l - 1)];
+    return (around[0] | around[1] | around[width] | around[width + 1]) != 0;
   };
   // A lower bound of each node's signed distance: the distance itself near the solid, the
   // distance to its bounding ball farther out. The distance is 1-Lipschitz, so a triangle
@@ -1242,7 +1236,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
     return cell_index(kc, lc) * kCellTriangles + static_cast<std::size_t>(tri);
   };
   const std::size_t triangles =
-      static_cast<std::size_t>(width) * (b.owned_l() + 1) * kCellTriangles;
+      static_cast<std::size_t>(width) * (b.owned_l() + 3) * kCellTriangles;
   if (slot_.size() != triangles) slot_.assign(triangles, -1);
   // Visits a cell: its pushes, and the bound of its distance its tests found (−∞ when a
   // triangle needed the search).
@@ -1366,7 +1360,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       const TileRange cells = tile_cell_nodes(i, j);
       for (int lc = cells.l0; lc < cells.l1; ++lc)
         for (int kc = cells.k0; kc < cells.k1; ++kc) {
-          if (!live_cells_[flag(kc, lc)]) continue;
+          if (!live_cells_[cell_index(kc, lc)]) continue;
           const double found = visit(kc, lc, pushes);
           if (remembers && owned_cell(kc, lc))
             clear[cell_index(kc, lc)] = found + reach_[tile(i, j)].since;
@@ -1381,7 +1375,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   pushed_.assign(cells_near_.size(), 0);
   for (const CellPush& push : cells_) {
     const auto cell = static_cast<int>(push.triangle / kCellTriangles);
-    const int kc = cell % width + b.k0 - 1, lc = cell / width + b.l0 - 1;
+    const int kc = cell % width + b.k0 - 2, lc = cell / width + b.l0 - 2;
     for (int v = 0; v < 4; ++v) {
       const int k = kc + (v & 1), l = lc + (v >> 1);
       if (b.owns(k, l)) pushed_[tile((k - b.k0) / kTile, (l - b.l0) / kTile)] = 1;
