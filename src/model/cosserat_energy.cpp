@@ -9,6 +9,17 @@
 #include "energy_interior.hpp"
 #include "surface_geometry.hpp"
 
+// The interior rows are most of a step's time, and a portable x86-64 build (the release
+// preset) vectorises them two doubles wide. Such a build carries a second copy compiled for
+// AVX2, four wide, taken where the CPU has AVX2 (docs/kernel.md, "The run-time wide kernel").
+// The copy may use no FMA, so that it rounds every operation as the portable one does: the same
+// bits on every x86-64 CPU. A build for a CPU that has AVX2 already (-march=native) needs none.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX2__)
+#define COSSERAT_WIDE_KERNEL 1
+#else
+#define COSSERAT_WIDE_KERNEL 0
+#endif
+
 // Reach: E_p reads the 3 × 3 box around p, so the force at q reads the gradients of the nodes
 // p within one node of q, which read positions within two nodes of q: the same two ghost rings
 // as the flux form (kGhostWidth = 2). The gradients of the ring around the owned range are
@@ -145,7 +156,8 @@ CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const R
                                                h2)
                     : interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1,
                                             h2)},
-      terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)} {}
+      terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)},
+      wide_(wide_kernel_available()) {}
 
 double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGradient* gradient,
                                    Vec3* normal, Parts* parts) const {
@@ -472,6 +484,23 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
     if (lanes.template operator()<false>(block)) lanes.template operator()<true>(block);
 }
 
+#if COSSERAT_WIDE_KERNEL
+// "avx2" and not "arch=x86-64-v3", which would allow FMA. flatten inlines interior_row and
+// everything it calls, so all of it is compiled for AVX2.
+template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
+[[gnu::target("avx2"), gnu::flatten]] void CosseratEnergy::interior_row_wide(
+    int l, int ka, int kb, int k_base, RowScratch& s) const {
+  interior_row<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
+}
+
+bool CosseratEnergy::wide_kernel_available() {
+  static const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
+  return cpu_has_avx2;
+}
+#else
+bool CosseratEnergy::wide_kernel_available() { return false; }
+#endif
+
 // One border node through node_energy, into the row buffers.
 void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
                                  RowScratch& s) const {
@@ -536,7 +565,14 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
       load_row(R, l - 1, k_base, k_end, s);
       load_row(R, l, k_base, k_end, s);
       load_row(R, l + 1, k_base, k_end, s);
-      if (ka < kb) interior_row<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
+      if (ka < kb) {
+#if COSSERAT_WIDE_KERNEL
+        if (wide_)
+          interior_row_wide<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
+        else
+#endif
+          interior_row<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
+      }
       if (gk0 == 0) border_node(R, 0, l, k_base, s);
       if (gk1 == b.m) border_node(R, b.m - 1, l, k_base, s);
     }

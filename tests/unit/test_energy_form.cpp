@@ -285,6 +285,49 @@ TEST(EnergyForm, ForceIsTheGradientWhereCellsAreCrushed) {
   }
 }
 
+// A portable x86-64 build runs the interior rows through a copy of the kernel compiled for
+// AVX2 where the CPU has it (docs/kernel.md, "The run-time wide kernel"); its forces and normals
+// must be bitwise the portable copy's, so that a run gives the same bits on every x86-64 CPU:
+// on sheets crushed and not (the kernel's bounded and unbounded paths), with and without
+// bending and coupling, in both quadratures, with rows of several lane blocks and a remainder.
+TEST(EnergyForm, TheWideKernelGivesThePortableKernelsBits) {
+  if (!CosseratEnergy::wide_kernel_available())
+    GTEST_SKIP() << "this build has no wide copy of the kernel, or this CPU no AVX2";
+  for (const Quadrature q : kQuadratures)
+  for (const bool bending : {true, false})
+  for (const bool crush : {false, true}) {
+    SCOPED_TRACE(::testing::Message() << name(q) << (bending ? ", bending" : ", no bending")
+                                    << (crush ? ", crushed" : ", deformed"));
+    Scene scene = coupled_sheet();
+    scene.m = 29;
+    scene.n = 9;
+    if (!bending) scene.material.xi = scene.material.phi = {0.0, 0.0, 0.0};
+    Sheet sheet(scene, q);
+    if (crush) {
+      for (int l = 0; l < scene.n; ++l)
+        for (int k = 0; k < scene.m; ++k) sheet.r(k, l) = crushed(scene, k, l);
+      ASSERT_GE(crushed_corners(scene, sheet.r).first, 5);
+    }
+    ASSERT_TRUE(sheet.energy.wide_kernel());
+    Field<Vec3> wide(sheet.block), wide_normals(sheet.block);
+    sheet.energy.internal_force(sheet.r, wide, &wide_normals);
+    sheet.energy.set_wide_kernel(false);
+    ASSERT_FALSE(sheet.energy.wide_kernel());
+    Field<Vec3> portable(sheet.block), portable_normals(sheet.block);
+    sheet.energy.internal_force(sheet.r, portable, &portable_normals);
+    double largest = 0.0;
+    for (int l = 0; l < scene.n; ++l)
+      for (int k = 0; k < scene.m; ++k) {
+        largest = std::max(largest, norm(portable(k, l)));
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_EQ(wide(k, l)[c], portable(k, l)[c]) << "node " << k << ", " << l;
+          ASSERT_EQ(wide_normals(k, l)[c], portable_normals(k, l)[c]) << "node " << k << ", " << l;
+        }
+      }
+    ASSERT_GT(largest, 1.0);
+  }
+}
+
 // The stiffness of a rest sheet whose node p = (3, 3) is moved to within d h of the line
 // through its neighbours (4, 3) and (3, 4), so that p's corner triangle between them has |c| ~
 // d h² while its neighbours stay where they were. With c/|c| that corner's unit normal turns at

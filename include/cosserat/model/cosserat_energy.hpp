@@ -122,6 +122,15 @@ class CosseratEnergy {
   // hold the forces to the same bits on every split.
   RowBalance& row_balance() { return balance_; }
 
+  // Whether the interior rows run the kernel's 256-bit copy: a portable x86-64 build (the
+  // release preset) carries one compiled for AVX2 and takes it where the CPU has AVX2. It
+  // computes the same bits, and about twice as fast (docs/kernel.md, "The run-time wide
+  // kernel"). Settable for the test that holds the two copies to the same bits; where the
+  // build has no such copy or the CPU no AVX2, always false.
+  static bool wide_kernel_available();
+  bool wide_kernel() const { return wide_; }
+  void set_wide_kernel(bool wide) { wide_ = wide && wide_kernel_available(); }
+
  private:
   // One thread's row buffers (internal_force): three rows of positions and of forces, and one
   // row of gradients (nine slots) and normals, each component a contiguous array of `width`.
@@ -135,6 +144,9 @@ class CosseratEnergy {
   void load_row(const Field<Vec3>& positions, int l, int k_base, int k_end, RowScratch& s) const;
   template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
   void interior_row(int l, int ka, int kb, int k_base, RowScratch& s) const;
+  // interior_row compiled for AVX2, where the build's baseline lacks it (cosserat_energy.cpp).
+  template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
+  void interior_row_wide(int l, int ka, int kb, int k_base, RowScratch& s) const;
   void border_node(const Field<Vec3>& positions, int k, int l, int k_base, RowScratch& s) const;
   template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
   void band(const Field<Vec3>& positions, Field<Vec3>* normals, double scale,
@@ -164,6 +176,7 @@ class CosseratEnergy {
   energy::Terms terms_;
   std::vector<RowScratch> scratch_;  // one per thread, sized by the first internal_force
   RowBalance balance_;                // the threads' bands of owned rows
+  bool wide_;                         // interior rows through interior_row_wide
 };
 
 }  // namespace cosserat
