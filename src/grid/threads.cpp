@@ -172,11 +172,13 @@ void RowBalance::rebalance() {
 
 namespace {
 
-// A window ends after at least this many steps and this much wall time: long enough that one
+// A window ends after at least this much wall time and this many steps: long enough that one
 // descheduling of a few milliseconds does not decide it, short enough that a slow trial costs
-// little.
-constexpr long kWindowSteps = 20;
+// little. A few steps suffice where a step is long (a 1024² sheet's 45 ms).
+constexpr long kWindowSteps = 4;
 constexpr double kWindowSeconds = 0.05;
+// The steps that touch the fields and the row buffers for the first time, not timed.
+constexpr long kWarmSteps = 2;
 // Windows at the best count between two explorations: with two candidates, one window in
 // this many is spent timing the other, a few per cent of a run at most.
 constexpr long kHoldWindows = 40;
@@ -185,9 +187,15 @@ constexpr long kCheckWindows = 3;
 // A candidate must be this much faster to replace the one in use: timing noise on a VM is a
 // few per cent (docs/kernel.md).
 constexpr double kMargin = 0.95;
+// A trial is cut short once it has taken this much longer than the best so far would have for
+// its steps: a team waiting for a descheduled thread runs five times slower on a busy machine,
+// and a whole window of it cost short runs up to twice their time (docs/parallel.md).
+constexpr double kAbandonSeconds = 0.005;
 
 }  // namespace
 
+// Explorations time the count in use first, for a fresh yardstick, then the others; the first
+// starts at one thread, which no other count can make a run slower than.
 ThreadTuner::ThreadTuner(int most) {
   for (int t = std::max(most, 1); t >= 1; t /= 2) {
     counts_.push_back(t);
@@ -196,7 +204,9 @@ ThreadTuner::ThreadTuner(int most) {
   per_step_.assign(counts_.size(), 0.0);
   steps_with_.assign(static_cast<std::size_t>(std::max(most, 1)), 0);
   exploring_ = counts_.size() > 1;
+  best_ = counts_.size() - 1;
   current_ = counts_.front();
+  use(counts_[best_]);
 }
 
 void ThreadTuner::use(int threads) {
@@ -204,24 +214,36 @@ void ThreadTuner::use(int threads) {
   current_ = threads;
 }
 
+// The candidate timed at position `trial` of an exploration: the best first, then the others.
+std::size_t ThreadTuner::candidate(std::size_t trial) const {
+  if (trial == 0) return best_;
+  return trial <= best_ ? trial - 1 : trial;
+}
+
 void ThreadTuner::record(double seconds) {
   ++steps_with_[static_cast<std::size_t>(current_ - 1)];
   if (counts_.size() < 2) return;
   ++window_steps_;
   window_seconds_ += seconds;
-  if (window_steps_ < kWindowSteps || window_seconds_ < kWindowSeconds) return;
+  if (!warm_) {
+    if (window_steps_ < kWarmSteps) return;
+    warm_ = true;
+    window_steps_ = 0;
+    window_seconds_ = 0.0;
+    return;
+  }
+  const bool hopeless =
+      exploring_ && trial_ > 0 &&
+      window_seconds_ > yardstick_ * static_cast<double>(window_steps_) + kAbandonSeconds;
+  if (!hopeless && (window_steps_ < kWindowSteps || window_seconds_ < kWindowSeconds)) return;
   const double per_step = window_seconds_ / static_cast<double>(window_steps_);
   window_steps_ = 0;
   window_seconds_ = 0.0;
-  // The first window touches the fields and the row buffers for the first time.
-  if (!warm_) {
-    warm_ = true;
-    return;
-  }
   if (exploring_) {
-    per_step_[trial_] = per_step;
+    per_step_[candidate(trial_)] = per_step;
+    yardstick_ = trial_ == 0 ? per_step : std::min(yardstick_, per_step);
     if (++trial_ < counts_.size()) {
-      use(counts_[trial_]);
+      use(counts_[candidate(trial_)]);
       return;
     }
     // The one in use before keeps its place unless another is clearly faster.
@@ -244,7 +266,6 @@ void ThreadTuner::record(double seconds) {
   if (!disappointing && windows_held_ < kHoldWindows) return;
   exploring_ = true;
   trial_ = 0;
-  use(counts_[0]);
 }
 
 }  // namespace cosserat

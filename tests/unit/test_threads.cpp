@@ -2,6 +2,8 @@
 // count (reductions run in a fixed order, each node's update is independent).
 
 #include <gtest/gtest.h>
+
+#include <cstdio>
 #include <omp.h>
 
 #include "cosserat/grid/threads.hpp"
@@ -134,6 +136,38 @@ TEST(ThreadTuner, KeepsTheFastestCountAndFollowsTheMachine) {
   const std::vector<long>& steps = tuner.steps_with();
   ASSERT_EQ(steps.size(), 2u);
   EXPECT_EQ(steps[0] + steps[1], 8000);
+}
+
+// The simulated seconds `steps` take on such a machine with the tuner choosing.
+double tuned_seconds(const std::vector<double>& seconds_with, long steps) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(static_cast<int>(seconds_with.size()));
+  ThreadTuner tuner(static_cast<int>(seconds_with.size()));
+  double total = 0.0;
+  for (long i = 0; i < steps; ++i) {
+    const double seconds = seconds_with[static_cast<std::size_t>(omp_get_max_threads() - 1)];
+    total += seconds;
+    tuner.record(seconds);
+  }
+  omp_set_num_threads(before);
+  return total;
+}
+
+// The round tablecloth's 0.5 s as measured on the 2-core VM (benchmarks/run_thread_load.sh,
+// 2026-12-04): 625 steps of 0.37 ms on one thread; two threads take 0.25 ms on the idle
+// machine and 1.8 ms with another program busy on one core. Timing two threads for whole
+// windows made the busy run twice as long as one thread's; the tuner now starts at one thread
+// and cuts a hopeless trial short.
+TEST(ThreadTuner, AShortRunIsNeverMuchSlowerThanOneThread) {
+  const long steps = 625;
+  const double one = 0.37e-3;
+  const double busy = tuned_seconds({one, 1.8e-3}, steps);
+  const double idle = tuned_seconds({one, 0.25e-3}, steps);
+  std::printf("[tuner] %ld steps: busy %.3f s, idle %.3f s; one thread %.3f s, two idle %.3f s\n",
+              steps, busy, idle, steps * one, steps * 0.25e-3);
+  EXPECT_LT(busy, 1.05 * steps * one);
+  EXPECT_LT(idle, steps * one);
+  EXPECT_LT(idle, 1.25 * steps * 0.25e-3);
 }
 
 TEST(ThreadTuner, OneThreadIsLeftAlone) {

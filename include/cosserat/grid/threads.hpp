@@ -71,7 +71,8 @@ class RowBalance {
 // fixes that from outside (OMP_WAIT_POLICY=passive came within 8–12 % of one thread, but cost
 // 48 % on S6 on an idle machine), so the tuner times each count it may use, 1 to the default
 // halving, over windows of steps, keeps the fastest, and times the others again now and then:
-// the machine's load changes during a run. Where the rows go changes no bit of the result.
+// the machine's load changes during a run. It starts at one thread, and cuts short the timing
+// of a count that is already clearly slower. Where the rows go changes no bit of the result.
 class ThreadTuner {
  public:
   // Tunes between 1 and `most` threads (the default count); with `most` = 1 it does nothing.
@@ -84,11 +85,13 @@ class ThreadTuner {
 
  private:
   void use(int threads);
+  std::size_t candidate(std::size_t trial) const;
 
   std::vector<int> counts_;        // the candidates: most, most/2, ..., 1
   std::vector<double> per_step_;   // each one's last measured seconds a step
   std::vector<long> steps_with_;
-  std::size_t trial_ = 0;          // the candidate being timed, while exploring
+  std::size_t trial_ = 0;          // the position in the exploration being timed (candidate())
+  double yardstick_ = 0.0;         // the exploration's best seconds a step so far
   bool exploring_ = true;
   bool warm_ = false;              // the first window was seen (and not counted)
   std::size_t best_ = 0;
