@@ -177,8 +177,11 @@ namespace {
 // little. A few steps suffice where a step is long (a 1024² sheet's 45 ms).
 constexpr long kWindowSteps = 4;
 constexpr double kWindowSeconds = 0.05;
-// The steps that touch the fields and the row buffers for the first time, not timed.
+// Steps not timed: a run's first (they touch the row buffers for the first time), and the
+// first at each new count (its team starts, and a thread new to the run sizes its buffers:
+// several milliseconds, which cut a trial of two threads short on an idle machine).
 constexpr long kWarmSteps = 2;
+constexpr long kSwitchSteps = 1;
 // Windows at the best count between two explorations: with two candidates, one window in
 // this many is spent timing the other, a few per cent of a run at most.
 constexpr long kHoldWindows = 40;
@@ -207,10 +210,14 @@ ThreadTuner::ThreadTuner(int most) {
   best_ = counts_.size() - 1;
   current_ = counts_.front();
   use(counts_[best_]);
+  skip_ = kWarmSteps;
 }
 
 void ThreadTuner::use(int threads) {
-  if (threads != current_) omp_set_num_threads(threads);
+  if (threads != current_) {
+    omp_set_num_threads(threads);
+    skip_ = std::max(skip_, kSwitchSteps);
+  }
   current_ = threads;
 }
 
@@ -223,15 +230,12 @@ std::size_t ThreadTuner::candidate(std::size_t trial) const {
 void ThreadTuner::record(double seconds) {
   ++steps_with_[static_cast<std::size_t>(current_ - 1)];
   if (counts_.size() < 2) return;
-  ++window_steps_;
-  window_seconds_ += seconds;
-  if (!warm_) {
-    if (window_steps_ < kWarmSteps) return;
-    warm_ = true;
-    window_steps_ = 0;
-    window_seconds_ = 0.0;
+  if (skip_ > 0) {
+    --skip_;
     return;
   }
+  ++window_steps_;
+  window_seconds_ += seconds;
   const bool hopeless =
       exploring_ && trial_ > 0 &&
       window_seconds_ > yardstick_ * static_cast<double>(window_steps_) + kAbandonSeconds;
