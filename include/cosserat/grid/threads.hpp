@@ -93,6 +93,7 @@ class ThreadTuner {
   std::size_t trial_ = 0;          // the position in the exploration being timed (candidate())
   double yardstick_ = 0.0;         // the exploration's best seconds a step so far
   bool exploring_ = true;
+  bool chosen_ = false;            // the first round has ended
   long skip_ = 0;                  // steps still to pass untimed
   std::size_t best_ = 0;
   long window_steps_ = 0;
