@@ -181,11 +181,8 @@ namespace {
 constexpr long kWindowSteps = 4;
 constexpr double kWindowSeconds = 0.05;
 constexpr double kFirstWindowSeconds = 0.01;
-// Steps not timed: a run's first (they touch the row buffers for the first time), and the
-// first at each new count (its team starts, and a thread new to the run sizes its buffers:
-// several milliseconds, which cut a trial of two threads short on an idle machine).
+// A run's first steps touch the row buffers for the first time, and are not timed.
 constexpr long kWarmSteps = 2;
-constexpr long kSwitchSteps = 1;
 // Windows at the best count between two explorations: with two candidates, one window in
 // this many is spent timing the other, a few per cent of a run at most.
 constexpr long kHoldWindows = 40;
@@ -194,15 +191,19 @@ constexpr long kCheckWindows = 3;
 // A candidate must be this much faster to replace the one in use: timing noise on a VM is a
 // few per cent (docs/kernel.md).
 constexpr double kMargin = 0.95;
-// A trial is cut short once it has taken this much longer than the best so far would have for
-// its steps: a team waiting for a descheduled thread runs five times slower on a busy machine,
-// and a whole window of it cost short runs up to twice their time (docs/parallel.md).
+// A trial is cut short once it has taken this much longer than kAbandonFactor times the best
+// so far would have for its steps: a team waiting for a descheduled thread runs five times
+// slower on a busy machine, and a whole window of it cost short runs up to twice their time
+// (docs/parallel.md). The factor keeps a trial that meets a costlier part of the run (cloth
+// landing on a table) from being cut short on an idle machine.
+constexpr double kAbandonFactor = 2.0;
 constexpr double kAbandonSeconds = 0.005;
 
 }  // namespace
 
-// Explorations time the count in use first, for a fresh yardstick, then the others; the first
-// starts at one thread, which no other count can make a run slower than.
+// Explorations time the count in use first, for a fresh yardstick, then the others. The first
+// starts at the default count, the best on an idle machine; on a busy one its short windows
+// cost a few milliseconds.
 ThreadTuner::ThreadTuner(int most) {
   for (int t = std::max(most, 1); t >= 1; t /= 2) {
     counts_.push_back(t);
@@ -211,17 +212,13 @@ ThreadTuner::ThreadTuner(int most) {
   per_step_.assign(counts_.size(), 0.0);
   steps_with_.assign(static_cast<std::size_t>(std::max(most, 1)), 0);
   exploring_ = counts_.size() > 1;
-  best_ = counts_.size() - 1;
+  best_ = 0;
   current_ = counts_.front();
-  use(counts_[best_]);
   skip_ = kWarmSteps;
 }
 
 void ThreadTuner::use(int threads) {
-  if (threads != current_) {
-    omp_set_num_threads(threads);
-    skip_ = std::max(skip_, kSwitchSteps);
-  }
+  if (threads != current_) omp_set_num_threads(threads);
   current_ = threads;
 }
 
@@ -242,7 +239,8 @@ void ThreadTuner::record(double seconds) {
   window_seconds_ += seconds;
   const bool hopeless =
       exploring_ && trial_ > 0 &&
-      window_seconds_ > yardstick_ * static_cast<double>(window_steps_) + kAbandonSeconds;
+      window_seconds_ >
+          kAbandonFactor * yardstick_ * static_cast<double>(window_steps_) + kAbandonSeconds;
   const double window = chosen_ ? kWindowSeconds : kFirstWindowSeconds;
   if (!hopeless && (window_steps_ < kWindowSteps || window_seconds_ < window)) return;
   const double per_step = window_seconds_ / static_cast<double>(window_steps_);

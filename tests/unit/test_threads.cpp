@@ -138,23 +138,21 @@ TEST(ThreadTuner, KeepsTheFastestCountAndFollowsTheMachine) {
   EXPECT_EQ(steps[0] + steps[1], 8000);
 }
 
-// The simulated seconds `steps` take on such a machine with the tuner choosing, where the
-// first step at a count new to the run costs `first_time` more (a thread new to the run sizes
-// its buffers) and the first after any other change 0.5 ms more (the team changes).
-double tuned_seconds(const std::vector<double>& seconds_with, long steps, double first_time) {
+// The simulated seconds `steps` take on such a machine with the tuner choosing, where a step
+// costs `falling` times as much before step `lands` (cloth falling onto a table runs no
+// contact) and the first step after the count changes 0.5 ms more (the team changes).
+double tuned_seconds(const std::vector<double>& seconds_with, long steps, long lands,
+                     double falling) {
   const int before = omp_get_max_threads();
   omp_set_num_threads(static_cast<int>(seconds_with.size()));
   ThreadTuner tuner(static_cast<int>(seconds_with.size()));
   double total = 0.0;
   int last = omp_get_max_threads();
-  std::vector<bool> seen(seconds_with.size() + 1, false);
   for (long i = 0; i < steps; ++i) {
     const int threads = omp_get_max_threads();
-    const auto t = static_cast<std::size_t>(threads);
-    double seconds = seconds_with[t - 1];
-    if (!seen[t]) seconds += first_time;
-    else if (threads != last) seconds += 0.5e-3;
-    seen[t] = true;
+    double seconds =
+        seconds_with[static_cast<std::size_t>(threads - 1)] * (i < lands ? falling : 1.0);
+    if (threads != last) seconds += 0.5e-3;
     last = threads;
     total += seconds;
     tuner.record(seconds);
@@ -164,25 +162,26 @@ double tuned_seconds(const std::vector<double>& seconds_with, long steps, double
 }
 
 // The round tablecloth's 0.5 s as measured on the 2-core VM (benchmarks/run_thread_load.sh,
-// 2026-12-04): 625 steps of 0.37 ms on one thread; two threads take 0.25 ms on the idle
-// machine and 1.8 ms with another program busy on one core, and the first step at a new count
-// a few ms more. Timing two threads for whole windows made the busy run twice as long as one
-// thread's; the tuner now starts at one thread and cuts a hopeless trial short, but not on the
-// cost of the switch itself (which kept the idle run at one thread). What it still pays to
-// learn that two threads are slow, one such first step and 5 ms, is under a tenth of this run.
+// 2026-12-04): 625 steps, of 0.1 ms on one thread while the cloth falls and 0.37 ms once it
+// lies on the table; two threads take two thirds of that on the idle machine and five times
+// as long with another program busy on one core. Timing two threads for whole windows of
+// 0.05 s made the busy run twice as long as one thread's; the tuner now times the first round
+// in short windows and cuts a hopeless trial short, but not one that meets the landing.
 TEST(ThreadTuner, AShortRunIsNeverMuchSlowerThanOneThread) {
   const long steps = 625;
-  const double one = 0.37e-3;
-  const double first_time = 8e-3;
-  const double busy = tuned_seconds({one, 1.8e-3}, steps, first_time);
-  const double idle = tuned_seconds({one, 0.25e-3}, steps, first_time);
-  // A run at a fixed count pays its first step too.
-  const double one_thread = steps * one + first_time, two_idle = steps * 0.25e-3 + first_time;
-  std::printf("[tuner] %ld steps: busy %.3f s, idle %.3f s; one thread %.3f s, two idle %.3f s\n",
-              steps, busy, idle, one_thread, two_idle);
-  EXPECT_LT(busy, 1.1 * one_thread);
-  EXPECT_LT(idle, one_thread);
-  EXPECT_LT(idle, 1.25 * two_idle);
+  const double one = 0.37e-3, falling = 0.27;
+  for (const long lands : {100L, 30L}) {
+    SCOPED_TRACE(::testing::Message() << "lands at step " << lands);
+    const double busy = tuned_seconds({one, 5.0 * one}, steps, lands, falling);
+    const double idle = tuned_seconds({one, 0.67 * one}, steps, lands, falling);
+    const double one_thread = one * (falling * lands + static_cast<double>(steps - lands));
+    const double two_idle = 0.67 * one_thread;
+    std::printf("[tuner] lands at %ld: busy %.3f s, idle %.3f s; one thread %.3f s, two idle "
+                "%.3f s\n", lands, busy, idle, one_thread, two_idle);
+    EXPECT_LT(busy, 1.1 * one_thread);
+    EXPECT_LT(idle, one_thread);
+    EXPECT_LT(idle, 1.25 * two_idle);
+  }
 }
 
 TEST(ThreadTuner, OneThreadIsLeftAlone) {

@@ -71,8 +71,9 @@ class RowBalance {
 // fixes that from outside (OMP_WAIT_POLICY=passive came within 8–12 % of one thread, but cost
 // 48 % on S6 on an idle machine), so the tuner times each count it may use, 1 to the default
 // halving, over windows of steps, keeps the fastest, and times the others again now and then:
-// the machine's load changes during a run. It starts at one thread, and cuts short the timing
-// of a count that is already clearly slower. Where the rows go changes no bit of the result.
+// the machine's load changes during a run. Its first round is quick, and it cuts short the
+// timing of a count that is already clearly slower. Where the rows go changes no bit of the
+// result.
 class ThreadTuner {
  public:
   // Tunes between 1 and `most` threads (the default count); with `most` = 1 it does nothing.
