@@ -162,9 +162,10 @@ double tuned_seconds(const std::vector<double>& seconds_with, long steps, long l
 }
 
 // The round tablecloth's 0.5 s as measured on the 2-core VM (benchmarks/run_thread_load.sh,
-// 2026-12-04): 625 steps, of 0.1 ms on one thread while the cloth falls and 0.37 ms once it
-// lies on the table; two threads take two thirds of that on the idle machine and five times
-// as long with another program busy on one core. Timing two threads for whole windows of
+// 2026-12-04): 625 steps in 0.23 s on one thread, 0.1 ms a step while the cloth falls and
+// about 0.37 ms once it lies on the table (the model's round numbers); two threads take two
+// thirds of that on the idle machine and five times as long or more with another program busy
+// on one core. Timing two threads for whole windows of
 // 0.05 s made the busy run twice as long as one thread's; the tuner now times the first round
 // in short windows and cuts a hopeless trial short, but not one that meets the landing.
 TEST(ThreadTuner, AShortRunIsNeverMuchSlowerThanOneThread) {
