@@ -213,7 +213,6 @@ ThreadTuner::ThreadTuner(int most) {
   per_step_.assign(counts_.size(), 0.0);
   steps_with_.assign(static_cast<std::size_t>(std::max(most, 1)), 0);
   exploring_ = counts_.size() > 1;
-  best_ = 0;
   current_ = counts_.front();
   skip_ = kWarmSteps;
 }
