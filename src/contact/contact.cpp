@@ -271,6 +271,10 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     row_boxes_.resize(static_cast<std::size_t>(tiles_k_) *
                       static_cast<std::size_t>(block.owned_l()));
     row_boxed_.resize(static_cast<std::size_t>(block.owned_l()));
+    band_far_.assign(static_cast<std::size_t>(tiles_l_), 0);
+    band_travel_.assign(static_cast<std::size_t>(tiles_l_), 0.0);
+    far_boxes_.resize(tiles);
+    row_move_.assign(static_cast<std::size_t>(block.owned_l()), 0.0);
     near_.resize(tiles);
     spare_.resize(tiles);
     tile_touched_.resize(tiles);
@@ -309,6 +313,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
         }
       }
   walk_boxes_ = planes_ < solids.size();
+  walk_after_ = planes_ != 1 || walk_boxes_;
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false, {}, {}, {}, {}, {}};
     if (spec.motion == SolidMotion::free) {
@@ -712,12 +717,12 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
     }
     for (int i = 0; i < lanes; ++i) {
       if (!a.met[i]) continue;
-      if (after.size() < static_cast<std::size_t>(b.owned_k())) {
-        after.resize(static_cast<std::size_t>(b.owned_k()));
-        settled_row.resize(after.size());
+      if (settled_row.size() < static_cast<std::size_t>(b.owned_k())) {
+        settled_row.resize(static_cast<std::size_t>(b.owned_k()));
+        if (walk_after_) after.resize(settled_row.size());
       }
       const int k = b.k0 + k0 + i;
-      after[static_cast<std::size_t>(count)] = {a.vx[i], a.vy[i], a.vz[i]};
+      if (walk_after_) after[static_cast<std::size_t>(count)] = {a.vx[i], a.vy[i], a.vz[i]};
       ends[k0 + i] = {a.rx[i], a.ry[i], a.rz[i]};
       settled_row[static_cast<std::size_t>(count)] = {k, l, {wx[i], wy[i], wz[i]}};
       ++count;
@@ -744,6 +749,30 @@ void Contact::walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& n
   static_assert(sizeof(Vec3) == 3 * sizeof(double));
   constexpr int kValues = 3 * kTile;
   const Block& b = *block_;
+  const auto row = static_cast<std::size_t>(l - b.l0);
+  if (band_far_[row / kTile]) {
+    const double* a = &current(b.k0, l).x;
+    const double* e = &next(b.k0, l).x;
+    const int count = 3 * b.owned_k();
+    // Independent lanes, or each maximum waits for the one before it.
+    constexpr int kMaxLanes = 32;
+    double lanes[kMaxLanes] = {};
+    int v = 0;
+    for (; v + kMaxLanes <= count; v += kMaxLanes)
+#pragma omp simd
+      for (int i = 0; i < kMaxLanes; ++i) {
+        const double d = e[v + i] - a[v + i], d2 = d * d;
+        lanes[i] = d2 > lanes[i] ? d2 : lanes[i];
+      }
+    for (; v < count; ++v) {
+      const double d = e[v] - a[v], d2 = d * d;
+      lanes[0] = d2 > lanes[0] ? d2 : lanes[0];
+    }
+    double largest = 0.0;
+    for (const double lane : lanes) largest = lane > largest ? lane : largest;
+    row_move_[row] = largest;
+    return;
+  }
   BoxRun& run = box_runs_[static_cast<std::size_t>(omp_get_thread_num())];
   const auto values = static_cast<std::size_t>(kValues) * static_cast<std::size_t>(tiles_k_);
   if (run.low.size() != values) {
@@ -760,27 +789,24 @@ void Contact::walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& n
     run.open = true;
   }
   run.last = l;
-  const double* start = &current(b.k0, l).x;
-  const double* end = &next(b.k0, l).x;
-  for (int i = 0; i < tiles_k_; ++i) {
-    const int first = i * kTile, nodes = std::min(kTile, b.owned_k() - first);
-    double* low = run.low.data() + static_cast<std::ptrdiff_t>(kValues) * i;
-    double* high = run.high.data() + static_cast<std::ptrdiff_t>(kValues) * i;
-    double* square = run.square.data() + static_cast<std::ptrdiff_t>(kValues) * i;
-    const double* a = start + 3 * first;
-    const double* e = end + 3 * first;
-    const int count = 3 * nodes;
-    // A short tile's last slots stay empty. Selects of values: std::min and std::max return a
-    // reference to one of their arguments, which GCC vectorised as gathers from memory.
+  // Slot v of tile i is value 24 i + v of the run's arrays and of the row, so the row is one
+  // loop; a short last tile's slots past the row's end stay empty. Selects of values:
+  // std::min and std::max return a reference to one of their arguments, which GCC vectorised
+  // as gathers from memory. Tile by tile, the loop's remainder tests cost a third of it.
+  const double* a = &current(b.k0, l).x;
+  const double* e = &next(b.k0, l).x;
+  double* low = run.low.data();
+  double* high = run.high.data();
+  double* square = run.square.data();
+  const int count = 3 * b.owned_k();
 #pragma omp simd
-    for (int v = 0; v < count; ++v) {
-      const double from = a[v], to = e[v], d = to - from, d2 = d * d;
-      const double lo = low[v], hi = high[v], sq = square[v];
-      const double smaller = to < from ? to : from, larger = to < from ? from : to;
-      low[v] = smaller < lo ? smaller : lo;
-      high[v] = larger > hi ? larger : hi;
-      square[v] = d2 > sq ? d2 : sq;
-    }
+  for (int v = 0; v < count; ++v) {
+    const double from = a[v], to = e[v], d = to - from, d2 = d * d;
+    const double lo = low[v], hi = high[v], sq = square[v];
+    const double smaller = to < from ? to : from, larger = to < from ? from : to;
+    low[v] = smaller < lo ? smaller : lo;
+    high[v] = larger > hi ? larger : hi;
+    square[v] = d2 > sq ? d2 : sq;
   }
   if ((l - b.l0) % kTile == kTile - 1 || l == b.l1 - 1) close_box_run(run);
 }
@@ -824,6 +850,51 @@ void Contact::merge_rows(int i, int j) {
   const std::size_t t = tile(i, j);
   boxes_[t] = box;
   classify(t);
+}
+
+// A node moved at most √(3 m²) in a step whose largest squared move along an axis is m² (its
+// rows' row_move_), so the box kept when the band was found far, grown by the sum of those
+// bounds since (band_travel_), holds the band's nodes at both ends of this step: classify()
+// answers for it as for the tight box, if more cautiously.
+void Contact::far_box(int i, int j, double moved) {
+  const std::size_t t = tile(i, j);
+  const Box& kept = far_boxes_[t];
+  const double grown = band_travel_[static_cast<std::size_t>(j)] + moved;
+  const Vec3 grow{grown, grown, grown};
+  boxes_[t] = {kept.lo - grow, kept.hi + grow, moved};
+  classify(t);
+}
+
+double Contact::far_band_move(int j) const {
+  const TileRange r = tile_nodes(0, j);
+  double largest = 0.0;
+  for (int l = r.l0; l < r.l1; ++l)
+    largest = std::max(largest, row_move_[static_cast<std::size_t>(l - block_->l0)]);
+  return std::sqrt(3.0 * largest);
+}
+
+// A band stays far while every tile of it is found far from its grown boxes; one found far
+// from the walk's own boxes keeps them, with no travel yet. The next walk reads band_far_.
+void Contact::mark_far_bands() {
+  for (int j = 0; j < tiles_l_; ++j) {
+    const auto band = static_cast<std::size_t>(j);
+    bool far = true;
+    for (int i = 0; i < tiles_k_ && far; ++i) {
+      const std::size_t t = tile(i, j);
+      far = near_[t] == 0 && !tile_touched_[t];
+    }
+    if (!far) {
+      band_far_[band] = 0;
+      continue;
+    }
+    if (band_far_[band]) {
+      band_travel_[band] += boxes_[tile(0, j)].moved;
+      continue;
+    }
+    band_far_[band] = 1;
+    band_travel_[band] = 0.0;
+    for (int i = 0; i < tiles_k_; ++i) far_boxes_[tile(i, j)] = boxes_[tile(i, j)];
+  }
 }
 
 // The response moved node (k, l) of tile t: its box grows to hold where it is now, so that it
@@ -875,7 +946,8 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
       const NodeVelocity* walked = walk_settled_[row].data();
       const int count = walk_count_[row];
       for (int i = walk_at(row, 0, r.k0); i < count && walked[i].k < r.k1; ++i) {
-        velocity_(walked[i].k, l) = walk_velocity_[row][static_cast<std::size_t>(i)];
+        velocity_(walked[i].k, l) =
+            walk_after_ ? walk_velocity_[row][static_cast<std::size_t>(i)] : walked[i].velocity;
         touched_(walked[i].k, l) = kWalked;
       }
     }
@@ -1525,13 +1597,17 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
     for (BoxRun& run : box_runs_)
       if (run.open) close_box_run(run);
 #pragma omp parallel for schedule(static)
-  for (int j = 0; j < tiles_l_; ++j)
+  for (int j = 0; j < tiles_l_; ++j) {
+    const bool far = walked_ && walk_boxes_ && band_far_[static_cast<std::size_t>(j)];
+    const double far_move = far ? far_band_move(j) : 0.0;
     for (int i = 0; i < tiles_k_; ++i) {
       const std::size_t t = tile(i, j);
       tile_touched_[t] = 0;
       ready_[t] = 0;
       if (!walked_)
         make_box(i, j, current, next);
+      else if (far)
+        far_box(i, j, far_move);
       else if (walk_boxes_)
         merge_rows(i, j);
       else
@@ -1540,6 +1616,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
           (i == tiles_k_ - 1 && b.k1 < b.m) || (j == tiles_l_ - 1 && b.l1 < b.n))
         prepare(i, j, current, next);
     }
+  }
 
   std::vector<Exchange> exchanges;
   ContactStats stats;
@@ -1608,6 +1685,10 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
       corrected.add_run(settled_row + first, static_cast<std::size_t>(count - first));
     }
   }
+  if (!walked_)
+    std::fill(band_far_.begin(), band_far_.end(), 0);
+  else if (walk_boxes_)
+    mark_far_bands();
   walked_ = false;
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
   return stats;
@@ -1741,6 +1822,7 @@ void Contact::restore(const std::vector<double>& v) {
     s.proposed_pushing = s.pushing;
   }
   forget_clear();
+  std::fill(band_far_.begin(), band_far_.end(), 0);
 }
 
 }  // namespace cosserat

@@ -180,6 +180,76 @@ TEST(Contact, TheRowWalkGivesTheSameResponseAsRespondAlone) {
   expect_the_walk_gives_the_response_alone({solids[0], solids[1], ceiling}, true);
 }
 
+// A tile band found far from every solid is walked for its rows' largest moves alone, and its
+// boxes are the ones it was found far from, grown by how far its nodes can have moved since
+// (docs/contact.md, "Cost"). That only spares work: a crumpled sheet of 37 x 29 nodes falling
+// step by step onto a sphere and a box meets them in every step bitwise as respond() alone,
+// which never walks, with the rows walked in one band, two or three. Boxes not grown by the
+// travel fail this (checked): the bands stay far and the sheet passes through.
+TEST(Contact, FarBandsChangeNoStep) {
+  const int m = 37, n = 29;
+  const Decomposition decomposition = Decomposition::choose(m, n, 1);
+  const Block block = decomposition.block(0, MPI_COMM_SELF);
+  Halo halo(decomposition, block, 0);
+  const NodeMass mass{1e-3, m, n, true};
+  SolidSpec box;
+  box.shape.kind = ShapeKind::box;
+  box.shape.half_extents = {0.1, 0.05, 0.1};
+  box.pose.position = {-0.3, 0.0, 0.2};
+  std::vector<SolidSpec> solids{sphere({0.2, -0.05, -0.1}, 0.1), box};
+  for (SolidSpec& s : solids) s.thickness = 4e-3;
+  const double dt = 1e-3;
+  Field<Vec3> start(block);
+  for (int l = 0; l < n; ++l)
+    for (int k = 0; k < m; ++k) {
+      const Vec3 at{-0.5 + k / 36.0, 0.0, -0.5 + l / 28.0};
+      start(k, l) = at + Vec3{0.0, 0.2 + 0.008 * std::sin(7.0 * at.x) * std::cos(5.0 * at.z), 0.0};
+    }
+  const std::vector<std::vector<std::pair<int, int>>> orders{
+      {{0, n}}, {{n / 2, n}, {0, n / 2}}, {{13, n}, {10, 13}, {0, 10}}};
+  for (const auto& bands : orders) {
+    Contact alone(solids, block, halo, mass, {0.0, -9.81, 0.0}, 1.0 / 36.0);
+    Contact walked(solids, block, halo, mass, {0.0, -9.81, 0.0}, 1.0 / 36.0);
+    Field<Vec3> current = start, walked_current = start;
+    int most_far = 0;
+    long contacts = 0;
+    for (int step = 0; step < 40; ++step) {
+      const double time = step * dt;
+      Field<Vec3> next = current, walked_next = walked_current;
+      for (int l = 0; l < n; ++l)
+        for (int k = 0; k < m; ++k) {
+          const Vec3 fall{0.001 * std::cos(3.0 * k / 36.0), -0.008, 0.0005};
+          next(k, l) += fall;
+          walked_next(k, l) += fall;
+        }
+      NodeVelocities velocities, walked_velocities;
+      const ContactStats stats = alone.respond(time, dt, current, next, nullptr, velocities);
+      walked.begin_walk(time, dt);
+      for (const auto& [first, end] : bands)
+        for (int l = first; l < end; ++l) walked.walk_row(l, walked_current, walked_next);
+      const ContactStats walked_stats = walked.respond(time, dt, walked_current, walked_next,
+                                                       nullptr, walked_velocities);
+      EXPECT_EQ(walked_stats.contacts, stats.contacts) << "step " << step;
+      for (int l = 0; l < n; ++l)
+        for (int k = 0; k < m; ++k) {
+          ASSERT_EQ(walked_next(k, l).x, next(k, l).x) << k << ", " << l << " step " << step;
+          ASSERT_EQ(walked_next(k, l).y, next(k, l).y) << k << ", " << l << " step " << step;
+          ASSERT_EQ(walked_next(k, l).z, next(k, l).z) << k << ", " << l << " step " << step;
+        }
+      alone.accept();
+      walked.accept();
+      most_far = std::max(most_far, walked.far_bands());
+      contacts += stats.contacts;
+      current = next;
+      walked_current = walked_next;
+    }
+    // Every band was far before the sheet came down, and it then met both solids.
+    EXPECT_EQ(most_far, (n + 7) / 8);
+    EXPECT_LT(walked.far_bands(), (n + 7) / 8);
+    EXPECT_GT(contacts, 100);
+  }
+}
+
 TEST(Contact, CoulombFrictionHoldsBelowTheAngleOfReposeAndSlidesAbove) {
   const double mu = 0.5;
   double drift = 0.0;

@@ -4,6 +4,7 @@
 // owned nodes and owned cells, the free bodies' impulse sums exact and independent of the
 // decomposition, so every rank moves every body identically.
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -98,6 +99,10 @@ class Contact {
 
   // The proposed step was accepted: the solids take their proposed state.
   void accept();
+  // How many tile bands the next walk finds far from every solid (docs/contact.md, "Cost").
+  int far_bands() const {
+    return static_cast<int>(std::count(band_far_.begin(), band_far_.end(), 1));
+  }
 
   // Every solid's state (and the pushes still on) as numbers, for roll-backs and checkpoints;
   // restore() takes what state_vector() gave.
@@ -140,6 +145,12 @@ class Contact {
   void make_box(int i, int j, const Field<Vec3>& current, const Field<Vec3>& next);
   // The same from the rows walk_row() saw.
   void merge_rows(int i, int j);
+  // A far band's tile box: its box when the band was found far, grown by the band's travel
+  // and this step's move, `moved` (far_band_move).
+  void far_box(int i, int j, double moved);
+  double far_band_move(int j) const;
+  // After a walked response: which bands are far for the next step's walk.
+  void mark_far_bands();
   [[gnu::always_inline]] inline void grow_box(std::size_t t, int k, int l,
                                               const Field<Vec3>& current,
                                               const Field<Vec3>& next);
@@ -234,6 +245,15 @@ class Contact {
   // row_boxed_ says a run ended on that row (walk_boxes).
   std::vector<Box> row_boxes_;
   std::vector<unsigned char> row_boxed_;
+  // Per tile band: its every tile was found far from every solid (near_ 0, none touched) from
+  // the box kept in far_boxes_, and its nodes have moved at most band_travel_ since. For such
+  // a band the walk finds only each row's largest squared move along an axis (row_move_), and
+  // its tiles' boxes are the kept ones grown by the travel, until one is found near again
+  // (docs/contact.md, "Cost"). A restore() forgets them.
+  std::vector<unsigned char> band_far_;
+  std::vector<double> band_travel_;
+  std::vector<Box> far_boxes_;
+  std::vector<double> row_move_;
   // Per thread: its run of rows of one tile band so far, each tile column's 3 kTile values
   // (x, y, z of each node slot) of the least, greatest and largest squared move of its nodes.
   struct BoxRun {
@@ -258,6 +278,11 @@ class Contact {
   // deepest any sat inside one.
   std::vector<std::vector<NodeVelocity>> walk_settled_;
   std::vector<std::vector<Vec3>> walk_velocity_;
+  // Whether the walk keeps walk_velocity_. With one plane and nothing else, only a node left
+  // inside it reads the velocities again (a later pass, which the walk's move onto the plane
+  // leaves to round-off far from its coordinates); the velocity it leaves with stands in for
+  // its velocity after the plane, which it equals but for rounding (docs/contact.md, "Cost").
+  bool walk_after_ = true;
   std::vector<int> walk_count_;
   std::vector<int> walk_cuts_;  // respond(): a row's walk nodes that moved again after it
   std::vector<char> walk_inside_;
