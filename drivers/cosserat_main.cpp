@@ -178,8 +178,8 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
       std::ranges::count_if(scene.output_fields, [](cosserat::OutputField field) {
         return !cosserat::node_field(field).vector;
       }));
-  const double mine = cosserat::Simulation::memory_bytes(block, scene.integrator, scene.discretisation,
-                                                                 scalar_fields);
+  const double mine = cosserat::Simulation::memory_bytes(
+      block, scene.integrator, scene.discretisation, scalar_fields, scene.solids);
   double needed = 0.0;
   MPI_Allreduce(&mine, &needed, 1, MPI_DOUBLE, MPI_SUM, node);
   int node_rank = 0;

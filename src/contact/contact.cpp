@@ -639,6 +639,24 @@ int Contact::walk_at(std::size_t row, int from, int k) const {
       records);
 }
 
+double Contact::memory_bytes(const Block& block, const std::vector<SolidSpec>& solids) {
+  if (solids.empty()) return 0.0;
+  const double ghosted = static_cast<double>(block.local_size());
+  const double owned = static_cast<double>(block.owned_k()) * block.owned_l();
+  const double cells = static_cast<double>(block.owned_k() + 3) * (block.owned_l() + 3);
+  // velocity_, contact_normal_, surface_velocity_, normal_, local_; normal_speed_, distance_;
+  // touched_. The walk's two records per owned node; live_cells_; the tiles' boxes, flags
+  // and margins, about 150 bytes a tile of 64 nodes.
+  double bytes = ghosted * (5.0 * sizeof(Vec3) + 2.0 * sizeof(double) + 1.0) +
+                 owned * (sizeof(NodeVelocity) + sizeof(Vec3) + 150.0 / (kTile * kTile)) + cells;
+  for (const SolidSpec& spec : solids) {
+    if (spec.motion != SolidMotion::fixed || spec.shape.kind == ShapeKind::plane) continue;
+    bytes += cells * sizeof(double);
+    if (spec.shape.kind != ShapeKind::mesh) bytes += owned * sizeof(double);
+  }
+  return bytes;
+}
+
 void Contact::begin_walk(double time, double dt) {
   propose(time, dt);
   walked_ = true;

@@ -103,7 +103,8 @@ ContactSummary Simulation::contact_summary() const {
 }
 
 double Simulation::memory_bytes(const Block& block, Integrator integrator,
-                                Discretisation discretisation, std::size_t scalar_output_fields) {
+                                Discretisation discretisation, std::size_t scalar_output_fields,
+                                const std::vector<SolidSpec>& solids) {
   const double ghosted_nodes = static_cast<double>(block.local_size());
   const double owned_nodes = static_cast<double>(block.owned_k()) * block.owned_l();
   // rk4 keeps nine position-sized fields (state and new state of r and v, acceleration, two
@@ -120,7 +121,8 @@ double Simulation::memory_bytes(const Block& block, Integrator integrator,
   // 3 rows of 75 entries per node, the colouring's index of every entry, PETSc's vectors:
   // measured 13 KB per node (peak RSS 578 MB against Verlet's 59 MB on 200 x 200).
   const double baseline = integrator == Integrator::semi_implicit ? 13.5e3 * owned_nodes : 0.0;
-  return ghosted_nodes * per_node + row_buffers + output_buffer + baseline;
+  return ghosted_nodes * per_node + row_buffers + output_buffer + baseline +
+         Contact::memory_bytes(block, solids);
 }
 
 void Simulation::node_field(OutputField field, Field<double>& values) const {

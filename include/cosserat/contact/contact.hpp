@@ -74,6 +74,11 @@ class Contact {
   Contact(const Contact&) = delete;
   Contact& operator=(const Contact&) = delete;
 
+  // Upper bound of the memory a block's contact with `solids` takes, none without solids:
+  // its per-node fields, the walk's records and each fixed bounded solid's remembered
+  // clearances (docs/contact.md, "Cost").
+  static double memory_bytes(const Block& block, const std::vector<SolidSpec>& solids);
+
   std::size_t size() const { return solids_.size(); }
   const SolidSpec& spec(std::size_t i) const { return solids_[i].spec; }
   const SolidGeometry& geometry(std::size_t i) const { return solids_[i].geometry; }
