@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <exception>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -60,6 +61,25 @@ int node_cpus() {
   }
   return static_cast<int>(std::clamp(count, 1L, online));
 }
+
+}  // namespace
+
+int online_cpu_count() { return static_cast<int>(online_cpus()); }
+
+int others_running(int mine) {
+  std::ifstream file("/proc/stat");
+  for (std::string line; std::getline(file, line);) {
+    if (line.rfind("procs_running ", 0) != 0) continue;
+    try {
+      return std::max(0, std::stoi(line.substr(14)) - mine);
+    } catch (const std::exception&) {
+      return 0;
+    }
+  }
+  return 0;
+}
+
+namespace {
 
 bool explicit_thread_count() {
   const char* value = std::getenv("OMP_NUM_THREADS");
@@ -174,11 +194,12 @@ namespace {
 
 // A window ends after at least this much wall time and this many steps: long enough that one
 // descheduling of a few milliseconds does not decide it, short enough that a slow trial costs
-// little. A few steps suffice where a step is long (a 1024² sheet's 45 ms). The first round's
-// windows are shorter, so that a short run does not spend most of itself at its first count
-// (the round tablecloth's 0.5 s takes 0.23 s on one thread, 0.1 ms a step while the cloth
-// falls): a choice made on them is checked in the windows that follow (kCheckWindows) and timed
-// again if it disappoints.
+// little. A few steps suffice where a step is long (a 1024² sheet's 45 ms). Until a choice
+// has passed its checks (the kCheckWindows windows after it) the windows are shorter, so that
+// a short run does not spend most of itself at its first counts (the round tablecloth's 0.5 s
+// takes 0.23 s on one thread, 0.1 ms a step while the cloth falls and about four times that
+// once it lies on the table): a choice made on the falling cloth against a trial on the
+// landing one disappoints in its checks, and is timed again soon.
 constexpr long kWindowSteps = 4;
 constexpr double kWindowSeconds = 0.05;
 constexpr double kFirstWindowSeconds = 0.01;
@@ -199,13 +220,22 @@ constexpr double kMargin = 0.95;
 // landing on a table) from being cut short on an idle machine.
 constexpr double kAbandonFactor = 2.0;
 constexpr double kAbandonSeconds = 0.005;
+// The count in use is timed afresh at once, without finishing its window, once the window has
+// taken this much longer than kHeldFactor times what the count took when chosen: a team
+// waiting for a descheduled thread ran 7 to 80 times slower than it had in its trial on the
+// round tablecloth with another program busy (docs/parallel.md), where the cloth's landing
+// makes a step about 4 times as costly on an idle machine.
+constexpr double kHeldFactor = 5.0;
 
 }  // namespace
 
 // Explorations time the count in use first, for a fresh yardstick, then the others. The first
-// starts at the default count, the best on an idle machine; on a busy one its short windows
-// cost a few milliseconds.
-ThreadTuner::ThreadTuner(int most) {
+// starts at one thread, which no other count can make a run slower than: a trial of more is
+// cut short when it is hopeless, where a first window at the default count, with no yardstick
+// yet, ran whole on a busy machine (its descheduled steps cost the round tablecloth's 0.5 s
+// 0.02-0.05 s of its 0.23 s).
+ThreadTuner::ThreadTuner(int most, std::function<int(int)> others, int cpus)
+    : others_(std::move(others)), cpus_(std::max(cpus, 1)) {
   for (int t = std::max(most, 1); t >= 1; t /= 2) {
     counts_.push_back(t);
     if (t == 1) break;
@@ -214,6 +244,8 @@ ThreadTuner::ThreadTuner(int most) {
   steps_with_.assign(static_cast<std::size_t>(std::max(most, 1)), 0);
   exploring_ = counts_.size() > 1;
   current_ = counts_.front();
+  best_ = counts_.size() - 1;
+  use(counts_[best_]);
   skip_ = kWarmSteps;
 }
 
@@ -237,20 +269,36 @@ void ThreadTuner::record(double seconds) {
   }
   ++window_steps_;
   window_seconds_ += seconds;
+  const double steps = static_cast<double>(window_steps_);
   const bool hopeless =
       exploring_ && trial_ > 0 &&
-      window_seconds_ >
-          kAbandonFactor * yardstick_ * static_cast<double>(window_steps_) + kAbandonSeconds;
-  const double window = chosen_ ? kWindowSeconds : kFirstWindowSeconds;
-  if (!hopeless && (window_steps_ < kWindowSteps || window_seconds_ < window)) return;
-  const double per_step = window_seconds_ / static_cast<double>(window_steps_);
+      window_seconds_ > kAbandonFactor * yardstick_ * steps + kAbandonSeconds;
+  const bool collapsed =
+      !exploring_ && window_seconds_ > kHeldFactor * per_step_[best_] * steps + kAbandonSeconds;
+  const double window = confirmed_ ? kWindowSeconds : kFirstWindowSeconds;
+  if (!hopeless && !collapsed && (window_steps_ < kWindowSteps || window_seconds_ < window))
+    return;
+  const double per_step = window_seconds_ / steps;
   window_steps_ = 0;
   window_seconds_ = 0.0;
+  if (collapsed) {
+    // The window stands for the count in use in a new exploration, which goes on to the others.
+    exploring_ = true;
+    trial_ = 0;
+  }
   if (exploring_) {
     per_step_[candidate(trial_)] = per_step;
     yardstick_ = trial_ == 0 ? per_step : std::min(yardstick_, per_step);
-    if (++trial_ < counts_.size()) {
-      use(counts_[candidate(trial_)]);
+    while (++trial_ < counts_.size()) {
+      // Waking a thread whose core another program holds took 37-68 ms on the round
+      // tablecloth with a busy loop beside it, a sixth of its 0.23 s, however short the trial
+      // (docs/parallel.md): a count the machine has no free cores for is not timed this round.
+      const std::size_t next = candidate(trial_);
+      if (counts_[next] > current_ && others_(current_) + counts_[next] > cpus_) {
+        per_step_[next] = std::numeric_limits<double>::infinity();
+        continue;
+      }
+      use(counts_[next]);
       return;
     }
     // The one in use before keeps its place unless another is clearly faster.
@@ -259,7 +307,6 @@ void ThreadTuner::record(double seconds) {
       if (per_step_[i] < kMargin * per_step_[best]) best = i;
     best_ = best;
     exploring_ = false;
-    chosen_ = true;
     windows_held_ = 0;
     held_seconds_ = 0.0;
     use(counts_[best_]);
@@ -271,6 +318,7 @@ void ThreadTuner::record(double seconds) {
   ++windows_held_;
   const bool disappointing = windows_held_ == kCheckWindows &&
                              held_seconds_ / kCheckWindows * kMargin > per_step_[best_];
+  if (windows_held_ == kCheckWindows && !disappointing) confirmed_ = true;
   if (!disappointing && windows_held_ < kHoldWindows) return;
   exploring_ = true;
   trial_ = 0;

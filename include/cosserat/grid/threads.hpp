@@ -6,6 +6,7 @@
 
 #include <mpi.h>
 
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -74,10 +75,19 @@ class RowBalance {
 // the machine's load changes during a run. Its first round is quick, and it cuts short the
 // timing of a count that is already clearly slower. Where the rows go changes no bit of the
 // result.
+// The tasks the machine is running now besides `mine` of this process's threads: Linux's
+// procs_running (/proc/stat) less `mine`, at least 0; 0 where it cannot be read.
+int others_running(int mine);
+// The machine's online CPUs, which procs_running counts across.
+int online_cpu_count();
+
 class ThreadTuner {
  public:
   // Tunes between 1 and `most` threads (the default count); with `most` = 1 it does nothing.
-  explicit ThreadTuner(int most);
+  // A count above the one in use is timed only while `others` (given the count in use) leaves
+  // it that many of the machine's `cpus`.
+  explicit ThreadTuner(int most, std::function<int(int)> others = others_running,
+                       int cpus = online_cpu_count());
   // After a step that took `seconds` (of wall time, the step alone): may set OpenMP's thread
   // count for the steps that follow.
   void record(double seconds);
@@ -88,13 +98,15 @@ class ThreadTuner {
   void use(int threads);
   std::size_t candidate(std::size_t trial) const;
 
+  std::function<int(int)> others_;
+  int cpus_ = 1;
   std::vector<int> counts_;        // the candidates: most, most/2, ..., 1
   std::vector<double> per_step_;   // each one's last measured seconds a step
   std::vector<long> steps_with_;
   std::size_t trial_ = 0;          // the position in the exploration being timed (candidate())
   double yardstick_ = 0.0;         // the exploration's best seconds a step so far
   bool exploring_ = true;
-  bool chosen_ = false;            // the first round has ended
+  bool confirmed_ = false;         // a choice has passed its checks (kCheckWindows)
   long skip_ = 0;                  // steps still to pass untimed
   std::size_t best_ = 0;
   long window_steps_ = 0;
