@@ -76,7 +76,8 @@ class RowBalance {
 // timing of a count that is already clearly slower. Where the rows go changes no bit of the
 // result.
 // The tasks the machine is running now besides `mine` of this process's threads: Linux's
-// procs_running (/proc/stat) less `mine`, at least 0; 0 where it cannot be read.
+// procs_running (/proc/stat), the least of three readings 0.1 ms apart, less `mine`, at least
+// 0; 0 where it cannot be read.
 int others_running(int mine);
 // The machine's online CPUs, which procs_running counts across.
 int online_cpu_count();
@@ -107,6 +108,7 @@ class ThreadTuner {
   double yardstick_ = 0.0;         // the exploration's best seconds a step so far
   bool exploring_ = true;
   bool confirmed_ = false;         // a choice has passed its checks (kCheckWindows)
+  bool skipped_ = false;           // this exploration left a count untimed (others_)
   long skip_ = 0;                  // steps still to pass untimed
   std::size_t best_ = 0;
   long window_steps_ = 0;
