@@ -72,9 +72,10 @@ class RowBalance {
 // fixes that from outside (OMP_WAIT_POLICY=passive came within 8–12 % of one thread, but cost
 // 48 % on S6 on an idle machine), so the tuner times each count it may use, 1 to the default
 // halving, over windows of steps, keeps the fastest, and times the others again now and then:
-// the machine's load changes during a run. Its first round is quick, and it cuts short the
-// timing of a count that is already clearly slower. Where the rows go changes no bit of the
-// result.
+// the machine's load changes during a run. Its first round is quick and starts at one thread,
+// it cuts short the timing of a count that is already clearly slower, and it does not time a
+// count the machine has no free cores for (waking a thread on a core another program holds
+// costs a whole descheduled step). Where the rows go changes no bit of the result.
 // The tasks the machine is running now besides `mine` of this process's threads: Linux's
 // procs_running (/proc/stat), the least of three readings 0.1 ms apart, less `mine`, at least
 // 0; 0 where it cannot be read.
