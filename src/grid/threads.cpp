@@ -238,7 +238,7 @@ constexpr double kAbandonFactor = 2.0;
 constexpr double kAbandonSeconds = 0.005;
 // The count in use is timed afresh at once, without finishing its window, once the window has
 // taken this much longer than kHeldFactor times what the count took when chosen: a team
-// waiting for a descheduled thread ran 7 to 80 times slower than it had in its trial on the
+// waiting for a descheduled thread ran 7 to 380 times slower than it had in its trial on the
 // round tablecloth with another program busy (docs/parallel.md), where the cloth's landing
 // makes a step about 4 times as costly on an idle machine.
 constexpr double kHeldFactor = 5.0;
@@ -249,7 +249,7 @@ constexpr double kHeldFactor = 5.0;
 // starts at one thread, which no other count can make a run slower than: a trial of more is
 // cut short when it is hopeless, where a first window at the default count, with no yardstick
 // yet, ran whole on a busy machine (its descheduled steps cost the round tablecloth's 0.5 s
-// 0.02-0.05 s of its 0.23 s).
+// 0.05 s or more of its 0.23 s).
 ThreadTuner::ThreadTuner(int most, std::function<int(int)> others, int cpus)
     : others_(std::move(others)), cpus_(std::max(cpus, 1)) {
   for (int t = std::max(most, 1); t >= 1; t /= 2) {

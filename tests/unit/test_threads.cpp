@@ -223,6 +223,22 @@ TEST(ThreadTuner, ACountTheMachineHasNoCoresForIsNotTried) {
   omp_set_num_threads(before);
 }
 
+// A count in use whose steps suddenly take many times what they took when it was chosen (its
+// team now waits for a thread another program descheduled) is left within a step or two,
+// not after its window and the checks: here two threads go from 0.6 ms a step to 20 ms.
+TEST(ThreadTuner, ACountThatCollapsesIsLeftAtOnce) {
+  const int before = omp_get_max_threads();
+  omp_set_num_threads(2);
+  ThreadTuner tuner(2, nothing_else, 2);
+  const long idle = steps_at(tuner, {1e-3, 0.6e-3}, 2, 2000);
+  ASSERT_GT(idle, 950);
+  ASSERT_EQ(omp_get_max_threads(), 2);
+  const long at_two = tuner.steps_with().at(1);
+  steps_at(tuner, {1e-3, 20e-3}, 1, 100);
+  omp_set_num_threads(before);
+  EXPECT_LE(tuner.steps_with().at(1) - at_two, 2);
+}
+
 TEST(ThreadTuner, OneThreadIsLeftAlone) {
   const int before = omp_get_max_threads();
   omp_set_num_threads(1);

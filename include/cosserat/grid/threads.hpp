@@ -63,6 +63,13 @@ class RowBalance {
   std::vector<double> row_cost_;  // seconds a row, smoothed over the steps
 };
 
+// The tasks the machine is running now besides `mine` of this process's threads: Linux's
+// procs_running (/proc/stat), the least of three readings 0.1 ms apart, less `mine`, at least
+// 0; 0 where it cannot be read.
+int others_running(int mine);
+// The machine's online CPUs, which procs_running counts across.
+int online_cpu_count();
+
 // Picks the size of a rank's thread team, step by step, from the steps' measured wall time
 // (docs/parallel.md, "Threads that fit the machine"). The default count suits an idle machine
 // (two threads run S2's 20 x 20 sheet 1.9 times as fast as one on two idle cores), but every
@@ -76,13 +83,6 @@ class RowBalance {
 // it cuts short the timing of a count that is already clearly slower, and it does not time a
 // count the machine has no free cores for (waking a thread on a core another program holds
 // costs a whole descheduled step). Where the rows go changes no bit of the result.
-// The tasks the machine is running now besides `mine` of this process's threads: Linux's
-// procs_running (/proc/stat), the least of three readings 0.1 ms apart, less `mine`, at least
-// 0; 0 where it cannot be read.
-int others_running(int mine);
-// The machine's online CPUs, which procs_running counts across.
-int online_cpu_count();
-
 class ThreadTuner {
  public:
   // Tunes between 1 and `most` threads (the default count); with `most` = 1 it does nothing.
