@@ -203,7 +203,8 @@ TEST(Contact, FarBandsChangeNoStep) {
   for (int l = 0; l < n; ++l)
     for (int k = 0; k < m; ++k) {
       const Vec3 at{-0.5 + k / 36.0, 0.0, -0.5 + l / 28.0};
-      start(k, l) = at + Vec3{0.0, 0.2 + 0.008 * std::sin(7.0 * at.x) * std::cos(5.0 * at.z), 0.0};
+      const double crumple = 0.008 * std::sin(7.0 * at.x) * std::cos(5.0 * at.z);
+      start(k, l) = at + Vec3{0.0, 0.2 + crumple, 0.0};
     }
   const std::vector<std::vector<std::pair<int, int>>> orders{
       {{0, n}}, {{n / 2, n}, {0, n / 2}}, {{13, n}, {10, 13}, {0, 10}}};

@@ -231,8 +231,8 @@ TEST(ThreadTuner, ACountThatCollapsesIsLeftAtOnce) {
   omp_set_num_threads(2);
   ThreadTuner tuner(2, nothing_else, 2);
   const long idle = steps_at(tuner, {1e-3, 0.6e-3}, 2, 2000);
-  ASSERT_GT(idle, 950);
-  ASSERT_EQ(omp_get_max_threads(), 2);
+  EXPECT_GT(idle, 950);
+  EXPECT_EQ(omp_get_max_threads(), 2);
   const long at_two = tuner.steps_with().at(1);
   steps_at(tuner, {1e-3, 20e-3}, 1, 100);
   omp_set_num_threads(before);
