@@ -62,12 +62,6 @@ int node_cpus() {
   return static_cast<int>(std::clamp(count, 1L, online));
 }
 
-}  // namespace
-
-int online_cpu_count() { return static_cast<int>(online_cpus()); }
-
-namespace {
-
 int procs_running() {
   std::ifstream file("/proc/stat");
   for (std::string line; std::getline(file, line);) {
@@ -81,7 +75,14 @@ int procs_running() {
   return 0;
 }
 
+bool explicit_thread_count() {
+  const char* value = std::getenv("OMP_NUM_THREADS");
+  return value != nullptr && *value != '\0';
+}
+
 }  // namespace
+
+int online_cpu_count() { return static_cast<int>(online_cpus()); }
 
 // The least of three readings 0.1 ms apart: a task that runs for a moment (a kernel thread, a
 // shell) is not another program holding a core, and one reading caught one often enough on the
@@ -94,15 +95,6 @@ int others_running(int mine) {
   }
   return std::max(0, least - mine);
 }
-
-namespace {
-
-bool explicit_thread_count() {
-  const char* value = std::getenv("OMP_NUM_THREADS");
-  return value != nullptr && *value != '\0';
-}
-
-}  // namespace
 
 ThreadPlacement place_threads(MPI_Comm comm, long rows, std::optional<int> requested) {
   MPI_Comm node;

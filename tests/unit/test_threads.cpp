@@ -141,6 +141,22 @@ TEST(ThreadTuner, KeepsTheFastestCountAndFollowsTheMachine) {
   EXPECT_EQ(steps[0] + steps[1], 8000);
 }
 
+// Runs `steps` simulated steps with the tuner choosing, step i at t threads costing
+// cost(i, t, switched), `switched` when the count changed for it; returns their seconds.
+template <class Cost>
+double simulate(ThreadTuner& tuner, long steps, Cost&& cost) {
+  double total = 0.0;
+  int last = omp_get_max_threads();
+  for (long i = 0; i < steps; ++i) {
+    const int threads = omp_get_max_threads();
+    const double seconds = cost(i, threads, threads != last);
+    last = threads;
+    total += seconds;
+    tuner.record(seconds);
+  }
+  return total;
+}
+
 // The simulated seconds `steps` take on such a machine with the tuner choosing, where a step
 // costs `falling` times as much before step `lands` (cloth falling onto a table runs no
 // contact) and the first step after the count changes 0.5 ms more (the team changes).
@@ -150,17 +166,10 @@ double tuned_seconds(const std::vector<double>& seconds_with, long steps, long l
   omp_set_num_threads(static_cast<int>(seconds_with.size()));
   ThreadTuner tuner(static_cast<int>(seconds_with.size()), nothing_else,
                     static_cast<int>(seconds_with.size()));
-  double total = 0.0;
-  int last = omp_get_max_threads();
-  for (long i = 0; i < steps; ++i) {
-    const int threads = omp_get_max_threads();
-    double seconds =
-        seconds_with[static_cast<std::size_t>(threads - 1)] * (i < lands ? falling : 1.0);
-    if (threads != last) seconds += 0.5e-3;
-    last = threads;
-    total += seconds;
-    tuner.record(seconds);
-  }
+  const double total = simulate(tuner, steps, [&](long i, int threads, bool switched) {
+    return seconds_with[static_cast<std::size_t>(threads - 1)] * (i < lands ? falling : 1.0) +
+           (switched ? 0.5e-3 : 0.0);
+  });
   omp_set_num_threads(before);
   return total;
 }
@@ -169,9 +178,9 @@ double tuned_seconds(const std::vector<double>& seconds_with, long steps, long l
 // 2026-12-04): 625 steps in 0.23 s on one thread, 0.1 ms a step while the cloth falls and
 // about 0.37 ms once it lies on the table (the model's round numbers); two threads take two
 // thirds of that on the idle machine and five times as long or more with another program busy
-// on one core. Timing two threads for whole windows of
-// 0.05 s made the busy run twice as long as one thread's; the tuner now times the first round
-// in short windows and cuts a hopeless trial short, but not one that meets the landing.
+// on one core. Timing two threads for whole windows of 0.05 s made the busy run twice as long
+// as one thread's; the tuner now times the first round in short windows and cuts a hopeless
+// trial short, but not one that meets the landing.
 TEST(ThreadTuner, AShortRunIsNeverMuchSlowerThanOneThread) {
   const long steps = 625;
   const double one = 0.37e-3, falling = 0.27;
@@ -201,16 +210,11 @@ TEST(ThreadTuner, ACountTheMachineHasNoCoresForIsNotTried) {
   int others = 1;
   ThreadTuner tuner(2, [&](int) { return others; }, 2);
   double seconds = 0.0;
-  int last = omp_get_max_threads();
   const auto run = [&](long steps) {
-    for (long i = 0; i < steps; ++i) {
-      const int threads = omp_get_max_threads();
+    seconds += simulate(tuner, steps, [&](long, int threads, bool switched) {
       const double wake = others > 0 ? 50e-3 : 0.5e-3;
-      const double step = (threads == 2 ? 0.6e-3 : 1e-3) + (threads != last ? wake : 0.0);
-      last = threads;
-      seconds += step;
-      tuner.record(step);
-    }
+      return (threads == 2 ? 0.6e-3 : 1e-3) + (switched ? wake : 0.0);
+    });
   };
   run(2000);
   EXPECT_EQ(tuner.steps_with().at(1), 0) << "two threads tried on a busy machine";

@@ -125,8 +125,8 @@ class CosseratEnergy {
   // Whether the interior rows run the kernel's 256-bit copy: a portable x86-64 build (the
   // release preset) carries one compiled for AVX2 and takes it where the CPU has AVX2. It
   // computes the same bits, and the step runs 2.4-2.7 times as fast (docs/kernel.md, "The
-  // run-time wide kernel"). Settable for the test that holds the two copies to the same bits; where the
-  // build has no such copy or the CPU no AVX2, always false.
+  // run-time wide kernel"). Settable for the test that holds the two copies to the same bits;
+  // where the build has no such copy or the CPU no AVX2, always false.
   static bool wide_kernel_available();
   bool wide_kernel() const { return wide_; }
   void set_wide_kernel(bool wide) { wide_ = wide && wide_kernel_available(); }
