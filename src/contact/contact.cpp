@@ -297,8 +297,6 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
     exchange_rows_.resize(static_cast<std::size_t>(tiles_l_));
     push_rows_.resize(static_cast<std::size_t>(tiles_l_));
     const auto rows = static_cast<std::size_t>(block.owned_l());
-    walk_velocity_.resize(rows);
-    walk_settled_.resize(rows);
     walk_count_.resize(rows);
     walk_inside_.resize(rows);
     walk_deepest_.resize(rows);
@@ -314,6 +312,11 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
       }
   walk_boxes_ = planes_ < solids.size();
   walk_after_ = planes_ != 1 || walk_boxes_;
+  if (planes_ > 0) {
+    const std::size_t owned = static_cast<std::size_t>(block.owned_k()) * block.owned_l();
+    walk_met_.assign(owned, 0);
+    if (walk_after_) walk_velocity_.resize(owned);
+  }
   for (const SolidSpec& spec : solids) {
     Solid s{spec, SolidGeometry(spec.shape), {}, {}, {}, false, false, {}, {}, {}, {}, {}};
     if (spec.motion == SolidMotion::free) {
@@ -448,9 +451,13 @@ bool Contact::meet_planes(Vec3& r, Vec3& v, Met&& met) const {
 // keeps what it had; what meet_plane() takes only on approach (the division by the tangential
 // speed) is guarded so that such a lane raises no floating-point exception. The walk met the
 // planes node by node before: 20 ns a node-step with a plane under every node at 1024²
-// (benchmarks/results/contact-lanes-*).
+// (benchmarks/results/contact-lanes-*). Sixteen lanes rather than eight: one plane's response
+// is a long chain of dependent operations, and eight lanes left the core waiting on it
+// (benchmarks/results/contact-starts-*).
 namespace {
-constexpr int kLanes = 8;
+constexpr int kLanes = 16;
+// |t|² < (1 − 1e-12) s² with s > 0 gives √|t|², rounded, below s.
+constexpr double kSureStick = 1.0 - 1e-12;
 }  // namespace
 
 struct Contact::PlaneLanes {
@@ -462,7 +469,7 @@ struct Contact::PlaneLanes {
   long met[kLanes];
 };
 
-void Contact::meet_planes(PlaneLanes& a) const {
+inline void Contact::meet_planes(PlaneLanes& a) const {
   for (int i = 0; i < kLanes; ++i) {
     a.nx[i] = a.ny[i] = a.nz[i] = a.ux[i] = a.uy[i] = a.uz[i] = a.speed[i] = 0.0;
     a.met[i] = 0;
@@ -488,53 +495,88 @@ void Contact::meet_planes(PlaneLanes& a) const {
       any |= d[i] >= offset ? 0 : 1;
     }
     if (!any) continue;
+    double qx[kLanes], qy[kLanes], qz[kLanes], ux[kLanes], uy[kLanes], uz[kLanes];
+    double tx[kLanes], ty[kLanes], tz[kLanes], vn[kLanes], slip[kLanes], speed2[kLanes];
+    // A plane that does not turn has its velocity everywhere: u0 + 0 × c is u0, bit for bit.
+    const auto approach = [&]<bool Turning>() {
+      long sliding = 0;
+#pragma omp simd reduction(| : sliding)
+      for (int i = 0; i < kLanes; ++i) {
+        const double lift = offset - d[i];
+        qx[i] = a.rx[i] + lift * n.x;
+        qy[i] = a.ry[i] + lift * n.y;
+        qz[i] = a.rz[i] + lift * n.z;
+        if constexpr (Turning) {
+          const double cx = qx[i] - p.x, cy = qy[i] - p.y, cz = qz[i] - p.z;
+          ux[i] = u0.x + (w.y * cz - w.z * cy), uy[i] = u0.y + (w.z * cx - w.x * cz),
+          uz[i] = u0.z + (w.x * cy - w.y * cx);
+        } else {
+          ux[i] = u0.x, uy[i] = u0.y, uz[i] = u0.z;
+        }
+        // respond_velocity(v, surface, n, e, μ)
+        const double relx = a.vx[i] - ux[i], rely = a.vy[i] - uy[i], relz = a.vz[i] - uz[i];
+        vn[i] = relx * n.x + rely * n.y + relz * n.z;
+        tx[i] = relx - vn[i] * n.x, ty[i] = rely - vn[i] * n.y, tz[i] = relz - vn[i] * n.z;
+        slip[i] = mu * (bounce * vn[i]);
+        speed2[i] = tx[i] * tx[i] + ty[i] * ty[i] + tz[i] * tz[i];
+        // Coulomb's test |v_t| ≤ μ Δv_n without the square root, with a margin that covers
+        // its rounding: a lane that passes this sticks for certain.
+        const long hit = d[i] >= offset ? 0 : 1;
+        const long approaching = vn[i] >= 0.0 ? 0 : 1;
+        const long unsure = slip[i] > 0.0 ? 0 : 1;
+        const long close = speed2[i] < kSureStick * (slip[i] * slip[i]) ? 0 : 1;
+        sliding |= hit & approaching & (unsure | close);
+      }
+      return sliding;
+    };
+    const bool turning = w.x != 0.0 || w.y != 0.0 || w.z != 0.0;
+    const long sliding =
+        turning ? approach.template operator()<true>() : approach.template operator()<false>();
+    // Nodes lying still on a plane all stick: their lanes need no square root nor division.
+    const auto respond = [&]<bool Slide>() {
 #pragma omp simd
-    for (int i = 0; i < kLanes; ++i) {
-      const double lift = offset - d[i];
-      const double qx = a.rx[i] + lift * n.x, qy = a.ry[i] + lift * n.y,
-                   qz = a.rz[i] + lift * n.z;
-      const double cx = qx - p.x, cy = qy - p.y, cz = qz - p.z;
-      const double ux = u0.x + (w.y * cz - w.z * cy), uy = u0.y + (w.z * cx - w.x * cz),
-                   uz = u0.z + (w.x * cy - w.y * cx);
-      // respond_velocity(v, surface, n, e, μ)
-      const double relx = a.vx[i] - ux, rely = a.vy[i] - uy, relz = a.vz[i] - uz;
-      const double vn = relx * n.x + rely * n.y + relz * n.z;
-      const bool approaching = !(vn >= 0.0);
-      const double tx = relx - vn * n.x, ty = rely - vn * n.y, tz = relz - vn * n.z;
-      const double dvn = bounce * vn;
-      const double speed_t = std::sqrt(tx * tx + ty * ty + tz * tz);
-      const double slip = mu * dvn;
-      const bool stick = speed_t <= slip;
-      const double f = 1.0 - slip / (stick || !approaching ? 1.0 : speed_t);
-      const double ax = stick ? 0.0 : f * tx, ay = stick ? 0.0 : f * ty,
-                   az = stick ? 0.0 : f * tz;
-      const double kn = keep * vn;
-      const double outx = approaching ? (ux + kn * n.x) + ax : a.vx[i];
-      const double outy = approaching ? (uy + kn * n.y) + ay : a.vy[i];
-      const double outz = approaching ? (uz + kn * n.z) + az : a.vz[i];
-      const double chx = outx - a.vx[i], chy = outy - a.vy[i], chz = outz - a.vz[i];
-      // slip_correction(change, n)
-      const double cn = chx * n.x + chy * n.y + chz * n.z;
-      const double rx = qx + dt * (chx - cn * n.x), ry = qy + dt * (chy - cn * n.y),
-                   rz = qz + dt * (chz - cn * n.z);
-      const double vx = a.vx[i] + chx, vy = a.vy[i] + chy, vz = a.vz[i] + chz;
-      const double leaving = approaching ? keep * vn : vn;
-      const bool hit = !(d[i] >= offset);
-      a.rx[i] = hit ? rx : a.rx[i];
-      a.ry[i] = hit ? ry : a.ry[i];
-      a.rz[i] = hit ? rz : a.rz[i];
-      a.vx[i] = hit ? vx : a.vx[i];
-      a.vy[i] = hit ? vy : a.vy[i];
-      a.vz[i] = hit ? vz : a.vz[i];
-      a.nx[i] = hit ? n.x : a.nx[i];
-      a.ny[i] = hit ? n.y : a.ny[i];
-      a.nz[i] = hit ? n.z : a.nz[i];
-      a.ux[i] = hit ? ux : a.ux[i];
-      a.uy[i] = hit ? uy : a.uy[i];
-      a.uz[i] = hit ? uz : a.uz[i];
-      a.speed[i] = hit ? leaving : a.speed[i];
-      a.met[i] = hit ? 1 : a.met[i];
-    }
+      for (int i = 0; i < kLanes; ++i) {
+        const bool approaching = !(vn[i] >= 0.0);
+        double ax = 0.0, ay = 0.0, az = 0.0;
+        if constexpr (Slide) {
+          const double speed_t = std::sqrt(speed2[i]);
+          const bool stick = speed_t <= slip[i];
+          const double f = 1.0 - slip[i] / (stick || !approaching ? 1.0 : speed_t);
+          ax = stick ? 0.0 : f * tx[i], ay = stick ? 0.0 : f * ty[i],
+          az = stick ? 0.0 : f * tz[i];
+        }
+        const double kn = keep * vn[i];
+        const double outx = approaching ? (ux[i] + kn * n.x) + ax : a.vx[i];
+        const double outy = approaching ? (uy[i] + kn * n.y) + ay : a.vy[i];
+        const double outz = approaching ? (uz[i] + kn * n.z) + az : a.vz[i];
+        const double chx = outx - a.vx[i], chy = outy - a.vy[i], chz = outz - a.vz[i];
+        // slip_correction(change, n)
+        const double cn = chx * n.x + chy * n.y + chz * n.z;
+        const double rx = qx[i] + dt * (chx - cn * n.x), ry = qy[i] + dt * (chy - cn * n.y),
+                     rz = qz[i] + dt * (chz - cn * n.z);
+        const double vx = a.vx[i] + chx, vy = a.vy[i] + chy, vz = a.vz[i] + chz;
+        const double leaving = approaching ? keep * vn[i] : vn[i];
+        const bool hit = !(d[i] >= offset);
+        a.rx[i] = hit ? rx : a.rx[i];
+        a.ry[i] = hit ? ry : a.ry[i];
+        a.rz[i] = hit ? rz : a.rz[i];
+        a.vx[i] = hit ? vx : a.vx[i];
+        a.vy[i] = hit ? vy : a.vy[i];
+        a.vz[i] = hit ? vz : a.vz[i];
+        a.nx[i] = hit ? n.x : a.nx[i];
+        a.ny[i] = hit ? n.y : a.ny[i];
+        a.nz[i] = hit ? n.z : a.nz[i];
+        a.ux[i] = hit ? ux[i] : a.ux[i];
+        a.uy[i] = hit ? uy[i] : a.uy[i];
+        a.uz[i] = hit ? uz[i] : a.uz[i];
+        a.speed[i] = hit ? leaving : a.speed[i];
+        a.met[i] = hit ? 1 : a.met[i];
+      }
+    };
+    if (sliding)
+      respond.template operator()<true>();
+    else
+      respond.template operator()<false>();
   }
 }
 
@@ -629,26 +671,21 @@ void Contact::make_box(int i, int j, const Field<Vec3>& current, const Field<Vec
   classify(t);
 }
 
-// A row's walk records are in k's order: the first from `from` on of a node at k or after. A
-// scan from the row's start made prepare() quadratic along a row (46 % of it with ten solids).
-int Contact::walk_at(std::size_t row, int from, int k) const {
-  const NodeVelocity* records = walk_settled_[row].data();
-  return static_cast<int>(
-      std::lower_bound(records + from, records + walk_count_[row], k,
-                       [](const NodeVelocity& v, int key) { return v.k < key; }) -
-      records);
-}
-
 double Contact::memory_bytes(const Block& block, const std::vector<SolidSpec>& solids) {
   if (solids.empty()) return 0.0;
   const double ghosted = static_cast<double>(block.local_size());
   const double owned = static_cast<double>(block.owned_k()) * block.owned_l();
   const double cells = static_cast<double>(block.owned_k() + 3) * (block.owned_l() + 3);
   // velocity_, contact_normal_, surface_velocity_, normal_, local_; normal_speed_, distance_;
-  // touched_. The walk's two records per owned node; live_cells_; the tiles' boxes, flags
-  // and margins, about 150 bytes a tile of 64 nodes.
+  // touched_. live_cells_; the tiles' boxes, flags and margins, about 150 bytes a tile of 64
+  // nodes.
   double bytes = ghosted * (5.0 * sizeof(Vec3) + 2.0 * sizeof(double) + 1.0) +
-                 owned * (sizeof(NodeVelocity) + sizeof(Vec3) + 150.0 / (kTile * kTile)) + cells;
+                 owned * 150.0 / (kTile * kTile) + cells;
+  // With a plane, the walk's flag and velocity per owned node, and the Verlet family's next r⁻
+  // that it writes into (RowReader).
+  if (std::any_of(solids.begin(), solids.end(),
+                  [](const SolidSpec& spec) { return spec.shape.kind == ShapeKind::plane; }))
+    bytes += owned * (1.0 + sizeof(Vec3)) + ghosted * sizeof(Vec3);
   for (const SolidSpec& spec : solids) {
     if (spec.motion != SolidMotion::fixed || spec.shape.kind == ShapeKind::plane) continue;
     bytes += cells * sizeof(double);
@@ -657,9 +694,12 @@ double Contact::memory_bytes(const Block& block, const std::vector<SolidSpec>& s
   return bytes;
 }
 
-void Contact::begin_walk(double time, double dt) {
+void Contact::begin_walk(double time, double dt, Field<Vec3>* starts) {
+  if (planes_ > 0 && starts == nullptr)
+    throw std::logic_error("Contact::begin_walk: a walk that meets planes needs their starts");
   propose(time, dt);
   walked_ = true;
+  walk_starts_ = starts;
   dt_ = dt;
   if (walk_boxes_) {
     box_runs_.resize(static_cast<std::size_t>(omp_get_max_threads()));
@@ -673,40 +713,55 @@ void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
   if (walk_boxes_) walk_boxes(l, current, next);
 }
 
-// The planes first (order_), each node's as node_pass meets them, while the row is in cache;
-// the velocity it leaves with, as settled_velocity() gives it, kept for when nothing after
-// moves it again, and its velocity after the planes for prepare() when something may.
+// The planes first (order_), each node's as node_pass meets them, while the row is in cache.
+// A node they move leaves with the velocity settled_velocity() gives it, unless something
+// after them moves it again: the walk writes the r⁻ of that velocity into `starts`, and r for
+// the nodes it does not move, so the row of starts is whole. Which nodes it moved, and their
+// velocities after the planes, stay for prepare().
 void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) {
   const Block& b = *block_;
   const auto row = static_cast<std::size_t>(l - b.l0);
-  std::vector<Vec3>& after = walk_velocity_[row];
-  std::vector<NodeVelocity>& settled_row = walk_settled_[row];
+  const std::size_t first = row * static_cast<std::size_t>(b.owned_k());
+  unsigned char* met_row = &walk_met_[first];
+  Vec3* after = walk_after_ ? &walk_velocity_[first] : nullptr;
   int count = 0;
   double inside_lanes[kLanes] = {}, deepest_lanes[kLanes] = {};
+  // (r⁺ − r)/Δt as Vec3's division finds it: times the reciprocal.
   const double rate = 1.0 / dt_;
+  const double dt = dt_;
   PlaneLanes a;
   double sx[kLanes], sy[kLanes], sz[kLanes];
   double wx[kLanes], wy[kLanes], wz[kLanes];
-  const Vec3* starts = &current(b.k0, l);
+  const Vec3* origins = &current(b.k0, l);
   Vec3* ends = &next(b.k0, l);
+  Vec3* starts = &(*walk_starts_)(b.k0, l);
   for (int k0 = 0; k0 < b.owned_k(); k0 += kLanes) {
     // A row's last lanes repeat its last node, and are not read.
     const int lanes = std::min(kLanes, b.owned_k() - k0);
     for (int i = 0; i < kLanes; ++i) {
       const int k = k0 + std::min(i, lanes - 1);
       const Vec3 r = ends[k];
-      const Vec3 start = starts[k];
-      const Vec3 v = (r - start) / dt_;
+      const Vec3 start = origins[k];
       sx[i] = start.x, sy[i] = start.y, sz[i] = start.z;
       a.rx[i] = r.x, a.ry[i] = r.y, a.rz[i] = r.z;
-      a.vx[i] = v.x, a.vy[i] = v.y, a.vz[i] = v.z;
+    }
+#pragma omp simd
+    for (int i = 0; i < kLanes; ++i) {
+      a.vx[i] = (a.rx[i] - sx[i]) * rate;
+      a.vy[i] = (a.ry[i] - sy[i]) * rate;
+      a.vz[i] = (a.rz[i] - sz[i]) * rate;
     }
     meet_planes(a);
     long any = 0;
     for (int i = 0; i < kLanes; ++i) any |= a.met[i];
-    if (!any) continue;
+    if (!any) {
+      std::copy_n(origins + k0, lanes, starts + k0);
+      std::fill_n(met_row + k0, lanes, 0);
+      continue;
+    }
     // settled() of the velocity the node leaves with, operation for operation, as
-    // settled_velocity() finds it on a prepared tile.
+    // settled_velocity() finds it on a prepared tile; then VerletFamily::set_velocities' r⁻
+    // of it, the same way.
 #pragma omp simd
     for (int i = 0; i < kLanes; ++i) {
       const double mx = (a.rx[i] - sx[i]) * rate, my = (a.ry[i] - sy[i]) * rate,
@@ -714,9 +769,10 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
       const double normal =
           (mx - a.ux[i]) * a.nx[i] + (my - a.uy[i]) * a.ny[i] + (mz - a.uz[i]) * a.nz[i];
       const double lift = a.speed[i] - normal;
-      wx[i] = mx + lift * a.nx[i];
-      wy[i] = my + lift * a.ny[i];
-      wz[i] = mz + lift * a.nz[i];
+      const bool met = a.met[i] != 0;
+      wx[i] = met ? a.rx[i] - dt * (mx + lift * a.nx[i]) : sx[i];
+      wy[i] = met ? a.ry[i] - dt * (my + lift * a.ny[i]) : sy[i];
+      wz[i] = met ? a.rz[i] - dt * (mz + lift * a.nz[i]) : sz[i];
     }
     // any_inside()'s test of the planes, for the nodes they moved: the others are clear.
     for (std::size_t o = 0; o < planes_; ++o) {
@@ -733,18 +789,15 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
         inside_lanes[i] = met && d < level ? 1.0 : inside_lanes[i];
       }
     }
+    // A lane the planes did not meet keeps its end as it was.
     for (int i = 0; i < lanes; ++i) {
-      if (!a.met[i]) continue;
-      if (settled_row.size() < static_cast<std::size_t>(b.owned_k())) {
-        settled_row.resize(static_cast<std::size_t>(b.owned_k()));
-        if (walk_after_) after.resize(settled_row.size());
-      }
-      const int k = b.k0 + k0 + i;
-      if (walk_after_) after[static_cast<std::size_t>(count)] = {a.vx[i], a.vy[i], a.vz[i]};
       ends[k0 + i] = {a.rx[i], a.ry[i], a.rz[i]};
-      settled_row[static_cast<std::size_t>(count)] = {k, l, {wx[i], wy[i], wz[i]}};
-      ++count;
+      starts[k0 + i] = {wx[i], wy[i], wz[i]};
+      met_row[k0 + i] = static_cast<unsigned char>(a.met[i]);
+      count += static_cast<int>(a.met[i]);
     }
+    if (after != nullptr)
+      for (int i = 0; i < lanes; ++i) after[k0 + i] = {a.vx[i], a.vy[i], a.vz[i]};
   }
   double inside = 0.0, deepest = 0.0;
   for (int i = 0; i < kLanes; ++i) {
@@ -958,17 +1011,15 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
                                          : (next(k, l) - current(k, l)) / dt_;
       touched_(k, l) = 0;
     }
-  if (walked_)
-    for (int l = r.l0; l < r.l1; ++l) {
-      const auto row = static_cast<std::size_t>(l - block_->l0);
-      const NodeVelocity* walked = walk_settled_[row].data();
-      const int count = walk_count_[row];
-      for (int i = walk_at(row, 0, r.k0); i < count && walked[i].k < r.k1; ++i) {
-        velocity_(walked[i].k, l) =
-            walk_after_ ? walk_velocity_[row][static_cast<std::size_t>(i)] : walked[i].velocity;
-        touched_(walked[i].k, l) = kWalked;
+  if (walked_ && planes_ > 0)
+    for (int l = r.l0; l < r.l1; ++l)
+      for (int k = r.k0; k < r.k1; ++k) {
+        const std::size_t at = walk_index(k, l);
+        if (!walk_met_[at]) continue;
+        velocity_(k, l) = walk_after_ ? walk_velocity_[at]
+                                      : (next(k, l) - (*walk_starts_)(k, l)) / dt_;
+        touched_(k, l) = kWalked;
       }
-    }
   ready_[t] = 1;
 }
 
@@ -1663,7 +1714,6 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   // the walk's rows cut around them. Only the moves after the walk need the stability check's
   // edge test again.
   long local = 0;
-  std::vector<int>& cuts = walk_cuts_;
   for (int j = 0; j < tiles_l_; ++j) {
     bool any_ready = false;
     for (int i = 0; i < tiles_k_; ++i) {
@@ -1676,7 +1726,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
     }
     const TileRange rows = tile_nodes(0, j);
     for (int l = rows.l0; l < rows.l1; ++l) {
-      cuts.clear();
+      long moved_again = 0;
       if (any_ready)
         for (int i = 0; i < tiles_k_; ++i) {
           if (!ready_[tile(i, j)]) continue;
@@ -1686,21 +1736,12 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
             if (touched == 0 || touched == kWalked) continue;
             corrected.push_back({k, l, settled_velocity(k, l, current, next)});
             ++local;
-            if (touched & kWalked) cuts.push_back(k);
+            if (touched & kWalked) ++moved_again;
           }
         }
-      if (!walked_) continue;
-      const auto row = static_cast<std::size_t>(l - b.l0);
-      const NodeVelocity* settled_row = walk_settled_[row].data();
-      const int count = walk_count_[row];
-      local += count - static_cast<long>(cuts.size());
-      int first = 0;
-      for (const int k : cuts) {
-        const int at = walk_at(row, first, k);
-        corrected.add_run(settled_row + first, static_cast<std::size_t>(at - first));
-        first = at + 1;
-      }
-      corrected.add_run(settled_row + first, static_cast<std::size_t>(count - first));
+      // The walk gave the scheme the velocities of the others itself (begin_walk).
+      if (walked_ && planes_ > 0)
+        local += walk_count_[static_cast<std::size_t>(l - b.l0)] - moved_again;
     }
   }
   if (!walked_)
@@ -1708,6 +1749,7 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   else if (walk_boxes_)
     mark_far_bands();
   walked_ = false;
+  walk_starts_ = nullptr;
   MPI_Allreduce(&local, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
   return stats;
 }

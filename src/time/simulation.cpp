@@ -46,7 +46,10 @@ class Simulation::ContactAction final : public StepAction, public RowReader {
   }
   RowReader* row_reader() override { return this; }
   bool marks_moved_rows() const override { return true; }
-  void begin_walk(double time, double dt) override { contact_->begin_walk(time, dt); }
+  bool sets_velocities() const override { return contact_->walk_sets_velocities(); }
+  void begin_walk(double time, double dt, Field<Vec3>* starts) override {
+    contact_->begin_walk(time, dt, starts);
+  }
   void walk_row(int l, const Field<Vec3>& r, Field<Vec3>& next) override {
     contact_->walk_row(l, r, next);
   }

@@ -33,6 +33,7 @@ void VerletFamily::start(Field<Vec3> velocities) {
 
 std::optional<std::string> VerletFamily::advance(long step) {
   velocities_current_ = false;
+  walked_starts_ = false;
   return propose(step);
 }
 
@@ -70,7 +71,15 @@ void VerletFamily::centred_step(long step) {
     const Block& b = context_.block;
     const Constraints& constraints = context_.constraints;
     RowWalk* rows = context_.rows != nullptr && !context_.rows->empty() ? context_.rows : nullptr;
-    if (rows != nullptr) rows->begin_walk(context_.time, dt);
+    // A walk's reader that sets velocities writes the next step's r⁻ straight into the field
+    // that becomes it (RowReader::begin_walk).
+    Field<Vec3>* starts = nullptr;
+    if (rows != nullptr && rows->sets_velocities()) {
+      if (next_previous_.data() == nullptr) next_previous_ = Field<Vec3>(b);
+      starts = &next_previous_;
+      walked_starts_ = true;
+    }
+    if (rows != nullptr) rows->begin_walk(context_.time, dt, starts);
     dynamics.free_acceleration_rows(positions_, step, [&](int l, double* x, double* y, double* z) {
       const Vec3* r = &positions_(b.k0, l);
       const Vec3* rp = &previous_positions_(b.k0, l);
@@ -121,8 +130,12 @@ void VerletFamily::lagged_step(long step) {
 }
 
 void VerletFamily::accept_state() {
-  // rⁿ becomes rⁿ⁻¹; Scheme::accept then makes the proposed positions rⁿ.
-  previous_positions_.swap(positions_);
+  // rⁿ becomes rⁿ⁻¹, or what the walk made of it; Scheme::accept then makes the proposed
+  // positions rⁿ.
+  if (walked_starts_)
+    previous_positions_.swap(next_previous_);
+  else
+    previous_positions_.swap(positions_);
   dt_previous_ = context_.dt;
 }
 

@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
-#include <span>
 #include <vector>
 
 #include "cosserat/contact/geometry.hpp"
@@ -24,32 +23,20 @@ struct NodeVelocity {
   Vec3 velocity;
 };
 
-// The velocities a step's actions set: a list of their own, then runs of lists an action keeps
-// until the step is accepted (the contact's walk keeps each row's), so that a response that
-// sets every node's velocity copies none of them (docs/contact.md, "Cost"). A node is in it
-// once.
+// The velocities a step's actions set, a node once. The contact's walk sets those of the nodes
+// it settles on planes itself, in the scheme's r⁻ (RowReader::begin_walk).
 class NodeVelocities {
  public:
-  void clear() {
-    own_.clear();
-    runs_.clear();
-  }
+  void clear() { own_.clear(); }
   void push_back(const NodeVelocity& v) { own_.push_back(v); }
-  // `count` of another's list from `first`, which must hold until the step is accepted.
-  void add_run(const NodeVelocity* first, std::size_t count) {
-    if (count > 0) runs_.emplace_back(first, count);
-  }
-  bool empty() const { return own_.empty() && runs_.empty(); }
+  bool empty() const { return own_.empty(); }
   template <class Body>
   void for_each(Body&& body) const {
     for (const NodeVelocity& v : own_) body(v);
-    for (const std::span<const NodeVelocity>& run : runs_)
-      for (const NodeVelocity& v : run) body(v);
   }
 
  private:
   std::vector<NodeVelocity> own_;
-  std::vector<std::span<const NodeVelocity>> runs_;
 };
 
 // The state of a solid at one time.
@@ -98,9 +85,13 @@ class Contact {
   // While a scheme's row walk still has them in cache, for the step respond() is then called
   // for (from `time` by `dt`, velocities (next − current)/dt): row l meets the planes and
   // gives the broad phase its boxes, from any thread, each row once (docs/contact.md,
-  // "Cost"). A step without a walk leaves both to respond().
-  void begin_walk(double time, double dt);
+  // "Cost"). A step without a walk leaves both to respond(). With `starts` (RowReader), the
+  // velocities of the nodes the walk moves onto planes go there as r⁺ − Δt v, and
+  // respond() lists only those of nodes it moves again.
+  void begin_walk(double time, double dt, Field<Vec3>* starts = nullptr);
   void walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next);
+  // Whether a walk sets velocities: with a plane.
+  bool walk_sets_velocities() const { return planes_ > 0; }
 
   // The proposed step was accepted: the solids take their proposed state.
   void accept();
@@ -176,7 +167,7 @@ class Contact {
   bool meet_planes(Vec3& r, Vec3& v, Met&& met) const;
   // The same for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.
   struct PlaneLanes;
-  void meet_planes(PlaneLanes& lanes) const;
+  [[gnu::always_inline]] inline void meet_planes(PlaneLanes& lanes) const;
   // The height of r over plane s, along its normal.
   static double plane_height(const Solid& s, const Vec3& r) {
     return dot(r - s.proposed.pose.position, s.plane_normal);
@@ -188,8 +179,11 @@ class Contact {
   // The walk's two parts (walk_row).
   void walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next);
   void walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next);
-  // Row `row`'s first walk record from `from` on whose node is at k or after.
-  int walk_at(std::size_t row, int from, int k) const;
+  // An owned node's place in walk_met_ and walk_velocity_.
+  std::size_t walk_index(int k, int l) const {
+    return static_cast<std::size_t>(l - block_->l0) * static_cast<std::size_t>(block_->owned_k()) +
+           static_cast<std::size_t>(k - block_->k0);
+  }
   // Inline, with remember() and settled_velocity(): run for every node in contact, their
   // Vec3 arguments passed through memory cost more than their arithmetic.
   [[gnu::always_inline]] inline Vec3 velocity_change(const Solid& s, const Vec3& surface,
@@ -270,26 +264,25 @@ class Contact {
   void close_box_run(BoxRun& run);
   // walk_row() saw every row of this step, and begin_walk() proposed the solids' states.
   bool walked_ = false;
+  // The walk's `starts`, or null.
+  Field<Vec3>* walk_starts_ = nullptr;
   // The planes, and then the other solids, each in scene order: the order a node meets them.
   std::vector<std::size_t> order_;
   std::size_t planes_ = 0;        // how many of order_ are planes
   // Whether the walk finds the tiles' boxes: only a bounded solid needs them in a first pass.
   bool walk_boxes_ = false;
   std::uint64_t plane_bits_ = 0;  // their bits (solid_bit)
-  // Per owned row, from walk_row(): the nodes a plane moved, with the velocities they leave
-  // with if nothing else moves them, in k's order; beside each, its velocity after the planes,
-  // for the response's fields where it goes on (prepare). The first walk_count_ of each row's,
-  // sized for every node of a row once. Whether a node was left inside a plane, and the
-  // deepest any sat inside one.
-  std::vector<std::vector<NodeVelocity>> walk_settled_;
-  std::vector<std::vector<Vec3>> walk_velocity_;
+  // Per owned node, from walk_row(): whether a plane moved it, and its velocity after the
+  // planes, for the response's fields where it goes on (prepare); per owned row, how many it
+  // moved, whether one was left inside a plane, and the deepest any sat inside one.
+  std::vector<unsigned char> walk_met_;
+  std::vector<Vec3> walk_velocity_;
   // Whether the walk keeps walk_velocity_. With one plane and nothing else, only a node left
   // inside it reads the velocities again (a later pass, which the walk's move onto the plane
   // leaves to round-off far from its coordinates); the velocity it leaves with stands in for
   // its velocity after the plane, which it equals but for rounding (docs/contact.md, "Cost").
   bool walk_after_ = true;
   std::vector<int> walk_count_;
-  std::vector<int> walk_cuts_;  // respond(): a row's walk nodes that moved again after it
   std::vector<char> walk_inside_;
   std::vector<double> walk_deepest_;
   std::vector<std::uint64_t> near_;          // per tile: the solids (bit i) its nodes can meet

@@ -30,7 +30,9 @@ class EdgeCheck final : public RowReader {
   // and, if the same thread handed over the row below, the edges between the two.
   void begin_walk();
   void walk_row(int l, const Field<Vec3>& r, const Field<Vec3>& next);
-  void begin_walk(double /*time*/, double /*dt*/) override { begin_walk(); }
+  void begin_walk(double /*time*/, double /*dt*/, Field<Vec3>* /*starts*/) override {
+    begin_walk();
+  }
   void walk_row(int l, const Field<Vec3>& r, Field<Vec3>& next) override {
     walk_row(l, r, static_cast<const Field<Vec3>&>(next));
   }

@@ -169,6 +169,10 @@ class VerletFamily : public Scheme {
   Field<Vec3> lagged_velocity_;  // verlet-lagged: (rⁿ − rⁿ⁻¹)/Δt fed to the forces
   Field<Vec3> velocity_report_;  // what velocities() returns
   bool velocities_current_ = false;
+  // The next step's r⁻ as the step's row walk wrote it (RowReader::begin_walk), allocated
+  // for the first walk that sets velocities; walked_starts_: this step's walk did.
+  Field<Vec3> next_previous_;
+  bool walked_starts_ = false;
 };
 
 // What a scheme is built from: the scene (the scheme and its settings), the decomposition the
