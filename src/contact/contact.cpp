@@ -709,7 +709,14 @@ void Contact::begin_walk(double time, double dt, Field<Vec3>* starts) {
 }
 
 void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
-  if (planes_ > 0) walk_planes(l, current, next);
+  if (planes_ > 0) {
+#if COSSERAT_WIDE_COPIES
+    if (wide_walk_)
+      walk_planes_wide(l, current, next);
+    else
+#endif
+      walk_planes(l, current, next);
+  }
   if (walk_boxes_) walk_boxes(l, current, next);
 }
 
@@ -808,6 +815,15 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
   walk_inside_[row] = inside > 0.0 ? 1 : 0;
   walk_deepest_[row] = deepest;
 }
+
+#if COSSERAT_WIDE_COPIES
+// flatten inlines walk_planes and all it calls, so all of it is compiled for AVX2.
+[[gnu::target("avx2"), gnu::flatten]] void Contact::walk_planes_wide(int l,
+                                                                    const Field<Vec3>& current,
+                                                                    Field<Vec3>& next) {
+  walk_planes(l, current, next);
+}
+#endif
 
 // The tiles' boxes from the walk's rows, as the planes left them: each thread's run of rows of
 // a tile band is kept node slot by node slot, and folded onto x, y and z into row_boxes_ once,

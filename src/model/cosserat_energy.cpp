@@ -6,19 +6,11 @@
 #include <cmath>
 #include <vector>
 
+#include "cosserat/grid/wide_copy.hpp"
 #include "energy_interior.hpp"
 #include "surface_geometry.hpp"
 
-// The interior rows are most of a step's time, and a portable x86-64 build (the release
-// preset) vectorises them two doubles wide. Such a build carries a second copy compiled for
-// AVX2, four wide, taken where the CPU has AVX2 (docs/kernel.md, "The run-time wide kernel").
-// The copy may use no FMA, so that it rounds every operation as the portable one does: the same
-// bits on every x86-64 CPU. A build for a CPU that has AVX2 already (-march=native) needs none.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__AVX2__)
-#define COSSERAT_WIDE_KERNEL 1
-#else
-#define COSSERAT_WIDE_KERNEL 0
-#endif
+// The interior rows are most of a step's time: they have a wide copy (grid/wide_copy.hpp).
 
 // Reach: E_p reads the 3 × 3 box around p, so the force at q reads the gradients of the nodes
 // p within one node of q, which read positions within two nodes of q: the same two ghost rings
@@ -484,7 +476,7 @@ void CosseratEnergy::interior_row(int l, int ka, int kb, int k_base, RowScratch&
     if (lanes.template operator()<false>(block)) lanes.template operator()<true>(block);
 }
 
-#if COSSERAT_WIDE_KERNEL
+#if COSSERAT_WIDE_COPIES
 // "avx2" and not "arch=x86-64-v3", which would allow FMA. flatten inlines interior_row and
 // everything it calls, so all of it is compiled for AVX2.
 template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
@@ -493,13 +485,9 @@ template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
   interior_row<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
 }
 
-bool CosseratEnergy::wide_kernel_available() {
-  static const bool cpu_has_avx2 = __builtin_cpu_supports("avx2");
-  return cpu_has_avx2;
-}
-#else
-bool CosseratEnergy::wide_kernel_available() { return false; }
 #endif
+
+bool CosseratEnergy::wide_kernel_available() { return wide_copies_available(); }
 
 // One border node through node_energy, into the row buffers.
 void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,
@@ -566,7 +554,7 @@ void CosseratEnergy::band(const Field<Vec3>& R, Field<Vec3>* normals, double sca
       load_row(R, l, k_base, k_end, s);
       load_row(R, l + 1, k_base, k_end, s);
       if (ka < kb) {
-#if COSSERAT_WIDE_KERNEL
+#if COSSERAT_WIDE_COPIES
         if (wide_)
           interior_row_wide<Trapezoidal, Bending, Coupling, Normal>(l, ka, kb, k_base, s);
         else

@@ -94,9 +94,10 @@ double slide_acceleration(double theta, double mu, double* drift_when_stuck, lon
 // floor, a moving tilted plane, a sphere and a box, the proposed ends, the next step's r⁻ of
 // the Verlet family (which the walk writes itself for the nodes it settles) and the step's
 // figures are bitwise those of respond() alone, with the rows walked in one band, two or
-// three (threads' orders). With planes alone the walk finds
-// no boxes; a ceiling that faces the floor below the floor's surface leaves nodes inside, so
-// that the passes after the first find the boxes then, and meet the planes again.
+// three (threads' orders), by the walk's portable copy and its wide one where there is one.
+// With planes alone the walk finds no boxes; a ceiling that faces the floor below the floor's
+// surface leaves nodes inside, so that the passes after the first find the boxes then, and
+// meet the planes again.
 void expect_the_walk_gives_the_response_alone(const std::vector<SolidSpec>& solids,
                                               bool nodes_left_inside) {
   const int m = 37, n = 29;
@@ -134,29 +135,34 @@ void expect_the_walk_gives_the_response_alone(const std::vector<SolidSpec>& soli
   // ones first: the tiles' rows (8 of them) split between runs that end and start mid-tile.
   const std::vector<std::vector<std::pair<int, int>>> orders{
       {{0, n}}, {{n / 2, n}, {0, n / 2}}, {{13, n}, {10, 13}, {0, 10}}};
-  for (const auto& bands : orders) {
-    Contact walked(solids, block, halo, mass, {0.0, -9.81, 0.0}, 1.0 / 36.0);
-    Field<Vec3> walked_next = proposed;
-    Field<Vec3> walked_starts = current;
-    walked.begin_walk(time, dt, &walked_starts);
-    for (const auto& [first, end] : bands)
-      for (int l = first; l < end; ++l) walked.walk_row(l, current, walked_next);
-    NodeVelocities walked_velocities;
-    const ContactStats walked_stats =
-        walked.respond(time, dt, current, walked_next, nullptr, walked_velocities);
-    set_starts(walked_starts, walked_next, walked_velocities);
-    EXPECT_EQ(walked_stats.contacts, stats.contacts);
-    EXPECT_EQ(walked_stats.max_penetration, stats.max_penetration);
-    for (int l = 0; l < n; ++l)
-      for (int k = 0; k < m; ++k) {
-        ASSERT_EQ(walked_next(k, l).x, next(k, l).x) << k << ", " << l;
-        ASSERT_EQ(walked_next(k, l).y, next(k, l).y) << k << ", " << l;
-        ASSERT_EQ(walked_next(k, l).z, next(k, l).z) << k << ", " << l;
-        ASSERT_EQ(walked_starts(k, l).x, starts(k, l).x) << k << ", " << l;
-        ASSERT_EQ(walked_starts(k, l).y, starts(k, l).y) << k << ", " << l;
-        ASSERT_EQ(walked_starts(k, l).z, starts(k, l).z) << k << ", " << l;
-      }
-  }
+  // The walk's wide copy, where the build has one and the CPU runs it, and the portable one.
+  const std::vector<bool> copies =
+      wide_copies_available() ? std::vector<bool>{false, true} : std::vector<bool>{false};
+  for (const bool wide : copies)
+    for (const auto& bands : orders) {
+      Contact walked(solids, block, halo, mass, {0.0, -9.81, 0.0}, 1.0 / 36.0);
+      walked.set_wide_walk(wide);
+      Field<Vec3> walked_next = proposed;
+      Field<Vec3> walked_starts = current;
+      walked.begin_walk(time, dt, &walked_starts);
+      for (const auto& [first, end] : bands)
+        for (int l = first; l < end; ++l) walked.walk_row(l, current, walked_next);
+      NodeVelocities walked_velocities;
+      const ContactStats walked_stats =
+          walked.respond(time, dt, current, walked_next, nullptr, walked_velocities);
+      set_starts(walked_starts, walked_next, walked_velocities);
+      EXPECT_EQ(walked_stats.contacts, stats.contacts);
+      EXPECT_EQ(walked_stats.max_penetration, stats.max_penetration);
+      for (int l = 0; l < n; ++l)
+        for (int k = 0; k < m; ++k) {
+          ASSERT_EQ(walked_next(k, l).x, next(k, l).x) << k << ", " << l << " wide " << wide;
+          ASSERT_EQ(walked_next(k, l).y, next(k, l).y) << k << ", " << l;
+          ASSERT_EQ(walked_next(k, l).z, next(k, l).z) << k << ", " << l;
+          ASSERT_EQ(walked_starts(k, l).x, starts(k, l).x) << k << ", " << l;
+          ASSERT_EQ(walked_starts(k, l).y, starts(k, l).y) << k << ", " << l;
+          ASSERT_EQ(walked_starts(k, l).z, starts(k, l).z) << k << ", " << l;
+        }
+    }
 }
 
 // The floor's friction is low enough that some of its nodes slide and the others stick (the

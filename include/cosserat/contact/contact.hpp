@@ -14,6 +14,7 @@
 #include "cosserat/grid/block.hpp"
 #include "cosserat/model/node_mass.hpp"
 #include "cosserat/grid/halo.hpp"
+#include "cosserat/grid/wide_copy.hpp"
 
 namespace cosserat {
 
@@ -92,6 +93,11 @@ class Contact {
   void walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next);
   // Whether a walk sets velocities: with a plane.
   bool walk_sets_velocities() const { return planes_ > 0; }
+  // Whether the walk meets the planes in its AVX2 copy, with the same bits (grid/wide_copy.hpp):
+  // where the build has one and the CPU runs it. Settable for the test that holds the copies
+  // to the same bits.
+  bool wide_walk() const { return wide_walk_; }
+  void set_wide_walk(bool wide) { wide_walk_ = wide && wide_copies_available(); }
 
   // The proposed step was accepted: the solids take their proposed state.
   void accept();
@@ -176,8 +182,9 @@ class Contact {
   // projection onto the offset surface is not inside.
   bool inside_offset(double d, double offset) const { return d < inside_level(offset); }
   double inside_level(double offset) const { return offset - 1e-9 * (offset + spacing_); }
-  // The walk's two parts (walk_row).
+  // The walk's two parts (walk_row); the planes' wide copy (grid/wide_copy.hpp).
   void walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next);
+  void walk_planes_wide(int l, const Field<Vec3>& current, Field<Vec3>& next);
   void walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next);
   // An owned node's place in walk_met_ and walk_velocity_.
   std::size_t walk_index(int k, int l) const {
@@ -266,6 +273,7 @@ class Contact {
   bool walked_ = false;
   // The walk's `starts`, or null.
   Field<Vec3>* walk_starts_ = nullptr;
+  bool wide_walk_ = wide_copies_available();
   // The planes, and then the other solids, each in scene order: the order a node meets them.
   std::vector<std::size_t> order_;
   std::size_t planes_ = 0;        // how many of order_ are planes
