@@ -1725,10 +1725,10 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   MPI_Allreduce(&deepest, &stats.max_penetration, 1, MPI_DOUBLE, MPI_MAX, b.comm);
 
   if (any_free_) apply_impulses(exchanges);
-  // The velocities of the nodes the response moved: the walk's rows as they are, for the nodes
-  // nothing moved after the planes did; the others' from the fields on the tiles it prepared,
-  // the walk's rows cut around them. Only the moves after the walk need the stability check's
-  // edge test again.
+  // The velocities of the nodes the response moved after the walk, from the fields on the
+  // tiles it prepared; the walk wrote those of the others into the scheme's r⁻ (begin_walk),
+  // and counts them. Only the moves after the walk need the stability check's edge test
+  // again.
   long local = 0;
   for (int j = 0; j < tiles_l_; ++j) {
     bool any_ready = false;

@@ -314,5 +314,34 @@ TEST(DecompositionInvariance, ContactBroadPhaseFollowsTheOneBlockRun) {
   }
 }
 
+// With one plane and no other solid the walk settles the nodes on it alone, and writes their
+// r⁻ itself (docs/contact.md, "r⁻ written in the walk"): a sheet landing on a tilted floor
+// that some of its nodes slide down and others stick to follows the one-block run bitwise on
+// every split.
+TEST(DecompositionInvariance, ContactOnOneFloorFollowsTheOneBlockRun) {
+  Scene scene = testing::soft_sheet(13, 11, 1.2, 1.0, {-0.6, 0.05, -0.5});
+  scene.integrator = Integrator::verlet;
+  scene.steps = 250;
+  SolidSpec floor;
+  floor.name = "floor";
+  floor.shape.kind = ShapeKind::plane;
+  const Vec3 up{0.25, 1.0, 0.0};
+  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, up / norm(up));
+  floor.friction = 0.22;
+  floor.thickness = 2e-3;
+  scene.solids.push_back(floor);
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(reference, scene.steps));
+  ASSERT_GT(reference.contact_summary().max_contacts, 0);
+  for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+    Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+    ASSERT_TRUE(testing::advance(sim, scene.steps));
+    EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+        << "split " << split_name(d);
+    EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+        << "split " << split_name(d);
+  }
+}
+
 }  // namespace
 }  // namespace cosserat
