@@ -6,7 +6,6 @@
 #include <cmath>
 #include <vector>
 
-#include "cosserat/grid/wide_copy.hpp"
 #include "energy_interior.hpp"
 #include "surface_geometry.hpp"
 
@@ -149,7 +148,7 @@ CosseratEnergy::CosseratEnergy(const Block& block, double h1, double h2, const R
                     : interior_coefficients(rest.Phi, rest.Psi, rest.Theta, rest.metric, h1,
                                             h2)},
       terms_{any_nonzero(rest.Psi) || any_nonzero(rest.Theta), any_nonzero(rest.Theta)},
-      wide_(wide_kernel_available()) {}
+      wide_(wide_copies_available()) {}
 
 double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGradient* gradient,
                                    Vec3* normal, Parts* parts) const {
@@ -486,8 +485,6 @@ template <bool Trapezoidal, bool Bending, bool Coupling, bool Normal>
 }
 
 #endif
-
-bool CosseratEnergy::wide_kernel_available() { return wide_copies_available(); }
 
 // One border node through node_energy, into the row buffers.
 void CosseratEnergy::border_node(const Field<Vec3>& R, int k, int l, int k_base,

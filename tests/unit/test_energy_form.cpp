@@ -291,7 +291,7 @@ TEST(EnergyForm, ForceIsTheGradientWhereCellsAreCrushed) {
 // on sheets crushed and not (the kernel's bounded and unbounded paths), with and without
 // bending and coupling, in both quadratures, with rows of several lane blocks and a remainder.
 TEST(EnergyForm, TheWideKernelGivesThePortableKernelsBits) {
-  if (!CosseratEnergy::wide_kernel_available())
+  if (!wide_copies_available())
     GTEST_SKIP() << "this build has no wide copy of the kernel, or this CPU no AVX2";
   for (const Quadrature q : kQuadratures)
   for (const bool bending : {true, false})

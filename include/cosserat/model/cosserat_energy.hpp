@@ -9,6 +9,7 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/threads.hpp"
+#include "cosserat/grid/wide_copy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
 #include "cosserat/model/node_mass.hpp"
 #include "cosserat/grid/vec3.hpp"
@@ -126,10 +127,10 @@ class CosseratEnergy {
   // release preset) carries one compiled for AVX2 and takes it where the CPU has AVX2. It
   // computes the same bits, and the step runs 2.4-2.7 times as fast (docs/kernel.md, "The
   // run-time wide kernel"). Settable for the test that holds the two copies to the same bits;
-  // where the build has no such copy or the CPU no AVX2, always false.
-  static bool wide_kernel_available();
+  // where the build has no such copy or the CPU no AVX2 (wide_copies_available()), always
+  // false.
   bool wide_kernel() const { return wide_; }
-  void set_wide_kernel(bool wide) { wide_ = wide && wide_kernel_available(); }
+  void set_wide_kernel(bool wide) { wide_ = wide && wide_copies_available(); }
 
  private:
   // One thread's row buffers (internal_force): three rows of positions and of forces, and one
