@@ -27,7 +27,9 @@ Per frame, from /positions [frames, m, n, 3] (node [k, l] at [f, k, l, :], docs/
               largest |D_k - D_k+1| / 8 (metres: a for that zig-zag), "zz frac" the share of
               sum |D_k - D_k+1|^2 in sum |D_k - D_k+1|^2 + |D_k + D_k+1|^2 over both grid
               directions: sin²(π h/λ) for a fold of wavelength λ (0.024 at 20 nodes a
-              wavelength), 1 for a pure zig-zag.
+              wavelength), 1 for a pure zig-zag. A sheet flat to rounding (every |D_k| below
+              1e-12 of its largest coordinate) has no share ("—"): its second differences are
+              rounding noise, whose share says nothing (a flat sheet falling read 0.6-0.8).
 
 Prints a table (one line per frame, then the extremes over the run); --json prints one JSON
 object {"file", "grid", "h", "frames": [...], "overall": {...}} instead.
@@ -111,21 +113,24 @@ def proximity(r, h):
 
 def zigzag(r):
     """(largest grid-scale amplitude in metres, grid-scale share of the curvature) of one frame,
-    both grid directions together; (0, 0) on a sheet too small or too flat to say."""
+    both grid directions together; (0, None) on a sheet too small or too flat to say."""
     high = low = 0.0
     amplitude = 0.0
+    largest = 0.0
     for axis in (0, 1):
         x = np.moveaxis(r, axis, 0)
         if x.shape[0] < 4:
             continue
         d = x[2:] - 2.0 * x[1:-1] + x[:-2]
+        largest = max(largest, float(np.abs(d).max()))
         minus = d[1:] - d[:-1]
         plus = d[1:] + d[:-1]
         high += float((minus ** 2).sum())
         low += float((plus ** 2).sum())
         amplitude = max(amplitude, float(np.linalg.norm(minus, axis=-1).max()) / 8.0)
-    share = high / (high + low) if high + low > 0.0 else 0.0
-    return amplitude, share
+    if largest <= 1e-12 * float(np.abs(r).max()):
+        return amplitude, None
+    return amplitude, high / (high + low)
 
 
 def analyse(path, every=1):
