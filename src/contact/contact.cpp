@@ -412,36 +412,42 @@ Vec3 Contact::settled(const Vec3& moved, const Vec3& n, const Vec3& surface, dou
 
 // The step moved the node with its velocity before the response: friction's change of the
 // tangential velocity moves it too, Δt Δv_t, or a node that sticks would still creep by the
-// tangential a Δt² of every step.
-Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal) const {
-  return dt_ * (change - dot(change, normal) * normal);
+// tangential a Δt² of every step. That holds as it is for the Verlet family, whose move over a
+// step is Δt times the velocity it ends with. A scheme that carries velocities moves a node by
+// its own rule (velocity-verlet by Δt (v + ½aΔt), ending at v + aΔt): the tangential part of the
+// difference, `offset` (scheme_offset_), comes off too, or a node that stuck on a box crept by
+// ½ a_t Δt² a step and the drape never came to rest (tests/regression/test_contact_rest.cpp,
+// EverySchemeOverABox).
+Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal, const Vec3& offset) const {
+  const Vec3 slip = dt_ * (change - dot(change, normal) * normal);
+  if (next_velocities_ == nullptr) return slip;
+  return slip - (offset - dot(offset, normal) * normal);
 }
 
-bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface) const {
+bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface,
+                         const Vec3& offset) const {
   const Vec3& n = s.plane_normal;
-  const double offset = s.spec.thickness;
+  const double thickness = s.spec.thickness;
   const double d = plane_height(s, r);
-  if (d >= offset) return false;
-  const Vec3 point = r + (offset - d) * n;
+  if (d >= thickness) return false;
+  const Vec3 point = r + (thickness - d) * n;
   surface = surface_velocity(s.proposed, point);
   const Vec3 change = velocity_change(s, surface, n, v);
-  r = point + slip_correction(change, n);
+  r = point + slip_correction(change, n, offset);
   v = v + change;
   return true;
 }
 
-template <class Met>
-bool Contact::meet_planes(Vec3& r, Vec3& v, Met&& met) const {
-  bool any = false;
-  for (std::size_t o = 0; o < planes_; ++o) {
-    const Solid& s = solids_[order_[o]];
-    const Vec3 v_before = v;
-    Vec3 surface;
-    if (!meet_plane(s, r, v, surface)) continue;
-    met(s, surface, v_before);
-    any = true;
-  }
-  return any;
+// A node's scheme offset, taken off by the first response that corrects its move: that one
+// uses it up (take_offset).
+Vec3 Contact::scheme_offset_at(int k, int l) const {
+  return next_velocities_ ? scheme_offset_(k, l) : Vec3{};
+}
+
+Vec3 Contact::take_offset(int k, int l) {
+  const Vec3 offset = scheme_offset_at(k, l);
+  if (next_velocities_) scheme_offset_(k, l) = {};
+  return offset;
 }
 
 // Planes against kLanes nodes at once, written as meet_plane() is, operation for operation, as
@@ -681,6 +687,8 @@ double Contact::memory_bytes(const Block& block, const std::vector<SolidSpec>& s
   // nodes.
   double bytes = ghosted * (5.0 * sizeof(Vec3) + 2.0 * sizeof(double) + 1.0) +
                  owned * 150.0 / (kTile * kTile) + cells;
+  // The schemes that carry velocities: scheme_offset_ (a bound: the Verlet family has none).
+  bytes += ghosted * sizeof(Vec3);
   // With a plane, the walk's flag and velocity per owned node, and the Verlet family's next r⁻
   // that it writes into (RowReader).
   if (std::any_of(solids.begin(), solids.end(),
@@ -1026,6 +1034,8 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
       velocity_(k, l) = next_velocities_ ? (*next_velocities_)(k, l)
                                          : (next(k, l) - current(k, l)) / dt_;
       touched_(k, l) = 0;
+      if (next_velocities_)
+        scheme_offset_(k, l) = (next(k, l) - current(k, l)) - dt_ * (*next_velocities_)(k, l);
     }
   if (walked_ && planes_ > 0)
     for (int l = r.l0; l < r.l1; ++l)
@@ -1079,7 +1089,8 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
               Vec3& r = next(k, l);
               const Vec3 v_before = velocity_(k, l);
               Vec3 v = v_before, surface;
-              if (!meet_plane(s, r, v, surface)) continue;
+              if (!meet_plane(s, r, v, surface, scheme_offset_at(k, l))) continue;
+              take_offset(k, l);
               velocity_(k, l) = v;
               remember(s, k, l, s.plane_normal, surface, v_before);
               moved = grew = true;
@@ -1150,7 +1161,7 @@ void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
             const Vec3 v_before = velocity_(k, l);
             const Vec3 surface = surface_velocity(s.proposed, point);
             const Vec3 change = velocity_change(s, surface, n, v_before);
-            r = point + slip_correction(change, n);
+            r = point + slip_correction(change, n, take_offset(k, l));
             velocity_(k, l) = v_before + change;
             remember(s, k, l, n, surface, v_before);
             record(i, pass, 0, k, l, r_before, v_before, r, row);
@@ -1263,6 +1274,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   std::vector<double>& clear = clear_[solid];
   halo_->exchange(next);
   halo_->exchange(velocity_);
+  if (next_velocities_) halo_->exchange(scheme_offset_);
   // The broad phase: a tile's cells are visited only when the box of their nodes (the tile's
   // box and its next neighbours', ghosts added) comes closer than half the thickness to the
   // ball and to the box holding the solid. Every point of those cells lies in that box, and a
@@ -1494,16 +1506,18 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       }
       const double squares = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
       const Vec3 normal = s.proposed.pose.direction_to_world(side);
-      Vec3 velocity;
-      for (int v = 0; v < 3; ++v)
+      Vec3 velocity, point_offset;
+      for (int v = 0; v < 3; ++v) {
         velocity += w[v] * velocity_(nodes[v][0], nodes[v][1]);
+        point_offset += w[v] * scheme_offset_at(nodes[v][0], nodes[v][1]);
+      }
       CellPush push;
       push.triangle = triangle(kc, lc, tri);
       push.weights = {w[0] / squares, w[1] / squares, w[2] / squares};
       push.normal = normal;
       push.surface = surface_velocity(s.proposed, s.proposed.pose.to_world(point));
       push.velocity_change = velocity_change(s, push.surface, normal, velocity);
-      push.move = depth * normal + slip_correction(push.velocity_change, normal);
+      push.move = depth * normal + slip_correction(push.velocity_change, normal, point_offset);
       pushes.push_back(push);
     }
     return found;
@@ -1573,6 +1587,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
           const Vec3 v_before = velocity_(k, l);
           r += share * move;
           velocity_(k, l) += share * dv;
+          take_offset(k, l);
           remember(s, k, l, normal / norm(normal), share * surface, v_before);
           record(solid, pass, 1, k, l, r_before, v_before, r, exchanges);
           grow_box(tile(i, j), k, l, current, next);
@@ -1676,6 +1691,8 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   // With planes alone, the walk met them all and a first pass has nothing to do: the boxes
   // are found only if a node was left inside one (two planes that disagree), for the next.
   next_velocities_ = next_velocities;
+  if (next_velocities_ != nullptr && scheme_offset_.data() == nullptr)
+    scheme_offset_ = Field<Vec3>(b);
   const std::uint64_t first_pass = walked_ ? ~plane_bits_ : ~std::uint64_t{0};
   bool boxed = !walked_ || walk_boxes_;
   if (walked_ && walk_boxes_)

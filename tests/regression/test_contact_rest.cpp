@@ -194,31 +194,40 @@ TEST(ContactRest, ASheetDrapedOverABoxComesToRest) {
   expect_a_drape_over_a_table_at_rest(table, "box", 1e-5);
 }
 
-// The other schemes that start each step from the positions, or take the settled velocity
-// (docs/contact.md, "Velocities"), bring the drape over the box to rest the same way, with
-// velocities that say what the nodes move. Not rk4 and velocity-verlet: measured 2026-12-05,
-// rk4 ends at 7.4e-8 of its peak, its energy rises by up to 8.7e-6 J and a node hanging by the
-// box's corner reports 8.1e-4 m/s while moving 5.9e-6 m/s; velocity-verlet ends at 1.0e-9,
-// a node still moving 6.9e-6 m over the last frame (docs/contact.md, "Resting contact").
-class EverySchemeOverABox : public ::testing::TestWithParam<Integrator> {};
+// The other schemes bring the drape over the box to rest the same way, with velocities that say
+// what the nodes move (docs/contact.md, "Velocities"), and a total energy that rises between
+// frames by at most `largest_rise` of the peak kinetic energy: 1e-5 as for verlet, 2e-5 for
+// velocity-verlet (measured 1.3e-5, 2.8e-7 J at 1.45 s, where the cloth hangs over the box's
+// edges; verlet's is 2.8e-6 there). Not rk4: measured 2026-12-05, it ends at 3.0e-9 of its
+// peak, and a node by the box's top edge that no solid touches reports 1.4e-4 m/s while it
+// moves 2e-9 m a step, the scheme's own velocity, not the response's.
+struct SchemeCase {
+  Integrator integrator;
+  double largest_rise;
+};
+
+class EverySchemeOverABox : public ::testing::TestWithParam<SchemeCase> {};
 
 TEST_P(EverySchemeOverABox, ComesToRest) {
   Scene scene = resolved_sheet(0.05);
-  scene.integrator = GetParam();
+  scene.integrator = GetParam().integrator;
   SolidSpec table = solid(ShapeKind::box, {0.0, -0.5, 0.0}, 0.5);
   table.shape.half_extents = {0.15, 0.5, 0.15};
   scene.solids.push_back(table);
-  const std::string what = "box, " + integrator_name(GetParam());
+  const std::string what = "box, " + integrator_name(scene.integrator);
   const RestRecord r = run_to_rest(scene, 4.0);
-  expect_at_rest(r, what.c_str(), 1e-5);
+  expect_at_rest(r, what.c_str(), GetParam().largest_rise);
   EXPECT_GT(r.center_of_mass.y, -0.2) << what << ": slid off the table";
 }
 
 INSTANTIATE_TEST_SUITE_P(ContactRest, EverySchemeOverABox,
-                         ::testing::Values(Integrator::symplectic_euler, Integrator::leapfrog,
-                                           Integrator::tc_verlet, Integrator::verlet_lagged),
-                         [](const ::testing::TestParamInfo<Integrator>& info) {
-                           std::string name = integrator_name(info.param);
+                         ::testing::Values(SchemeCase{Integrator::symplectic_euler, 1e-5},
+                                           SchemeCase{Integrator::leapfrog, 1e-5},
+                                           SchemeCase{Integrator::velocity_verlet, 2e-5},
+                                           SchemeCase{Integrator::tc_verlet, 1e-5},
+                                           SchemeCase{Integrator::verlet_lagged, 1e-5}),
+                         [](const ::testing::TestParamInfo<SchemeCase>& info) {
+                           std::string name = integrator_name(info.param.integrator);
                            std::replace(name.begin(), name.end(), '-', '_');
                            return name;
                          });

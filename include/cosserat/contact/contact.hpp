@@ -162,16 +162,13 @@ class Contact {
   void propose_free(Solid& s, double dt) const;
   // Every solid's state at time + dt and what the broad phase needs of it.
   void propose(double time, double dt);
-  // A plane met by a node whose proposed end is r, moving at v: r goes onto its offset surface
-  // and v takes the response (CONTACT.md §3), `surface` the plane's velocity there. False, and
-  // nothing changed, when r is clear of it.
-  [[gnu::always_inline]] inline bool meet_plane(const Solid& s, Vec3& r, Vec3& v,
-                                                Vec3& surface) const;
-  // The planes in order against a node's proposed end r moving at v, as node_pass meets them,
-  // with met(s, surface, v_before) for each one met; whether any was.
-  template <class Met>
-  bool meet_planes(Vec3& r, Vec3& v, Met&& met) const;
-  // The same for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.
+  // A plane met by a node whose proposed end is r, moving at v, with scheme offset `offset`
+  // (slip_correction): r goes onto its offset surface and v takes the response (CONTACT.md
+  // §3), `surface` the plane's velocity there. False, and nothing changed, when r is clear of
+  // it.
+  [[gnu::always_inline]] inline bool meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface,
+                                                const Vec3& offset) const;
+  // The planes for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.
   struct PlaneLanes;
   [[gnu::always_inline]] inline void meet_planes(PlaneLanes& lanes) const;
   // The height of r over plane s, along its normal.
@@ -196,8 +193,12 @@ class Contact {
   [[gnu::always_inline]] inline Vec3 velocity_change(const Solid& s, const Vec3& surface,
                                                      const Vec3& normal,
                                                      const Vec3& velocity) const;
-  [[gnu::always_inline]] inline Vec3 slip_correction(const Vec3& change,
-                                                     const Vec3& normal) const;
+  [[gnu::always_inline]] inline Vec3 slip_correction(const Vec3& change, const Vec3& normal,
+                                                     const Vec3& offset) const;
+  // A node's scheme offset (scheme_offset_; zero for the Verlet family), and the same, used up
+  // by the response that corrects the node's move.
+  Vec3 scheme_offset_at(int k, int l) const;
+  Vec3 take_offset(int k, int l);
   void record(std::size_t solid, int pass, int phase, int k, int l, const Vec3& r_before,
               const Vec3& v_before, const Vec3& r_after, std::vector<Exchange>& out) const;
   // Node (k, l) met solid s with world normal n, arriving at `velocity` against a surface
@@ -239,6 +240,10 @@ class Contact {
   Field<Vec3> contact_normal_;     // their last contact's world normal
   Field<Vec3> surface_velocity_;   // and that surface's velocity there
   Field<double> normal_speed_;     // and the response's normal speed away from it
+  // Schemes that carry velocities: each node's move over the step beyond Δt times the velocity
+  // it ends with, until the response corrects its move (slip_correction). Allocated on the
+  // first step of such a scheme.
+  Field<Vec3> scheme_offset_;
   Field<double> distance_;         // cell_pass: a lower bound of each node's signed distance
   Field<Vec3> normal_;             // and the normal there (solid's frame), zero when far
   Field<Vec3> local_;              // cell_pass: each node's proposed end in the solid's frame
