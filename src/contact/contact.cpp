@@ -414,18 +414,19 @@ Vec3 Contact::settled(const Vec3& moved, const Vec3& n, const Vec3& surface, dou
 // tangential velocity moves it too, Δt Δv_t, or a node that sticks would still creep by the
 // tangential a Δt² of every step. That holds as it is for the Verlet family, whose move over a
 // step is Δt times the velocity it ends with. A scheme that carries velocities moves a node by
-// its own rule (velocity-verlet by Δt (v + ½aΔt), ending at v + aΔt): the tangential part of the
-// difference, `offset` (scheme_offset_), comes off too, or a node that stuck on a box crept by
-// ½ a_t Δt² a step and the drape never came to rest (tests/regression/test_contact_rest.cpp,
-// EverySchemeOverABox).
-Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal, const Vec3& offset) const {
+// its own rule (velocity-verlet by Δt (v + ½aΔt), ending at v + aΔt): the tangential part of
+// the difference, `scheme_offset` (scheme_offset_), comes off too, or a node that stuck on an
+// incline crept (1.52 m in 10 s in velocity-verlet) and one sliding slid at the wrong rate
+// (tests/unit/test_contact.cpp, the Coulomb tests).
+Vec3 Contact::slip_correction(const Vec3& change, const Vec3& normal,
+                              const Vec3& scheme_offset) const {
   const Vec3 slip = dt_ * (change - dot(change, normal) * normal);
   if (next_velocities_ == nullptr) return slip;
-  return slip - (offset - dot(offset, normal) * normal);
+  return slip - (scheme_offset - dot(scheme_offset, normal) * normal);
 }
 
 bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface,
-                         const Vec3& offset) const {
+                         const Vec3& scheme_offset) const {
   const Vec3& n = s.plane_normal;
   const double thickness = s.spec.thickness;
   const double d = plane_height(s, r);
@@ -433,7 +434,7 @@ bool Contact::meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface,
   const Vec3 point = r + (thickness - d) * n;
   surface = surface_velocity(s.proposed, point);
   const Vec3 change = velocity_change(s, surface, n, v);
-  r = point + slip_correction(change, n, offset);
+  r = point + slip_correction(change, n, scheme_offset);
   v = v + change;
   return true;
 }

@@ -162,12 +162,12 @@ class Contact {
   void propose_free(Solid& s, double dt) const;
   // Every solid's state at time + dt and what the broad phase needs of it.
   void propose(double time, double dt);
-  // A plane met by a node whose proposed end is r, moving at v, with scheme offset `offset`
+  // A plane met by a node whose proposed end is r, moving at v, with `scheme_offset`
   // (slip_correction): r goes onto its offset surface and v takes the response (CONTACT.md
   // §3), `surface` the plane's velocity there. False, and nothing changed, when r is clear of
   // it.
   [[gnu::always_inline]] inline bool meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface,
-                                                const Vec3& offset) const;
+                                                const Vec3& scheme_offset) const;
   // The planes for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.
   struct PlaneLanes;
   [[gnu::always_inline]] inline void meet_planes(PlaneLanes& lanes) const;
@@ -194,7 +194,7 @@ class Contact {
                                                      const Vec3& normal,
                                                      const Vec3& velocity) const;
   [[gnu::always_inline]] inline Vec3 slip_correction(const Vec3& change, const Vec3& normal,
-                                                     const Vec3& offset) const;
+                                                     const Vec3& scheme_offset) const;
   // A node's scheme offset (scheme_offset_; zero for the Verlet family), and the same, used up
   // by the response that corrects the node's move.
   Vec3 scheme_offset_at(int k, int l) const;
