@@ -9,6 +9,7 @@
 #include "cosserat/scene/scene.hpp"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <toml++/toml.h>
 
 #include <algorithm>
@@ -727,6 +728,34 @@ void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
   }
 }
 
+// docs/contact.md, "Crinkles": a drape whose grid holds fewer than about two spacings per
+// bending length c = (6 xi / (mu0 g))^(1/3) (docs/materials.md) folds in creases one node wide,
+// a zig-zag at the grid's scale that no response removes; about 2.4 keeps folds smooth. Said
+// for scenes with solids, which are the drapes, once per axis that falls short.
+void warn_if_folds_unresolved(const Origin& origin, Scene& scene) {
+  const double g = norm(scene.gravity);
+  if (scene.solids.empty() || g == 0.0) return;
+  constexpr double kCrease = 2.0;
+  constexpr double kSmooth = 2.4;
+  const double weight = scene.areal_density() * g;
+  const std::array<std::pair<double, double>, 2> axes{
+      {{scene.material.xi[0], scene.h1()}, {scene.material.xi[2], scene.h2()}}};
+  std::vector<std::string> short_axes;
+  for (std::size_t a = 0; a < axes.size(); ++a) {
+    const auto [xi, h] = axes[a];
+    const double c = std::cbrt(6.0 * xi / weight);
+    if (c < kCrease * h)
+      short_axes.push_back(fmt::format("{:.2f}{} along x{} (c = {:.3g} m, h = {:.3g} m)", c / h,
+                                       short_axes.empty() ? " spacings h per bending length c" : "",
+                                       a + 1, c, h));
+  }
+  if (short_axes.empty()) return;
+  scene.warnings.push_back(fmt::format(
+      "{}: the grid holds {}, so folds over the solids will crease at single nodes, a zig-zag "
+      "at the grid's scale (docs/contact.md, \"Crinkles\"); {} or more keep them smooth",
+      origin.path(), fmt::join(short_axes, " and "), kSmooth));
+}
+
 void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   root.allow(
       {"title", "grid", "material", "model", "environment", "time", "output", "fix", "load",
@@ -754,6 +783,7 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   // step, after the scheme, whatever the scheme.
   if (const auto solids = root.find("solid")) scene.solids = read_solids(*solids, scene);
   warn_if_not_positive_definite(origin, scene);
+  warn_if_folds_unresolved(origin, scene);
 }
 
 }  // namespace
