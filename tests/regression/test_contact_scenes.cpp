@@ -65,8 +65,9 @@ TEST(ContactScenes, AThinRodCarriesThePinnedSheet) {
 // straight back. The net, the cube and the throw are symmetric under the grid's three mirrors,
 // and so are the energy (docs/model.md, "Energy quadrature") and the cells' triangles
 // (docs/contact.md, "Symmetry"): the cube's horizontal offset at the top of its rebound is
-// round-off: 4.0e-11 m and 6.0e-10 m (measured; the 500 N cube rocks in the pocket for over a
-// second before it leaves, and round-off grows meanwhile). With the nodal quadrature it was
+// round-off: 4.2e-11 m and 3.3e-11 m (measured 2026-12-05; 4.0e-11 m and 6.0e-10 m before the
+// cell pass's shares, docs/contact.md "Cells", when the 500 N cube rocked in the pocket for
+// over a second before it left, and round-off grew meanwhile). With the nodal quadrature it was
 // 0.71 m and 0.31 m, with one diagonal for every cell 4.1e-9 m at 25 N, so 1e-9 m, the
 // criterion of the method's source, tells them apart.
 class CubeRebound : public ::testing::TestWithParam<std::string> {};

@@ -248,6 +248,9 @@ class Contact {
   Field<Vec3> normal_;             // and the normal there (solid's frame), zero when far
   Field<Vec3> local_;              // cell_pass: each node's proposed end in the solid's frame
   std::vector<CellPush> cells_;    // cell_pass: the triangles pressed in
+  // cell_pass: each node's sum over its pressed triangles, how many (x) and then how far their
+  // pushes lift it; a Vec3 so that the halo carries it. With bounded solids only.
+  Field<Vec3> node_sums_;
   std::vector<int> slot_;          // cell_pass: each triangle's index in cells_, or −1
   int tiles_k_ = 0, tiles_l_ = 0;
   std::vector<Box> boxes_;                   // per tile: its nodes at both ends of the step
