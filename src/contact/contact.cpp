@@ -1525,7 +1525,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
         }
       }
       // The push is one force at the point, shared among the nodes as its weights say:
-      // node i moves by (w_i / m_i) / Σ w_j² / m_j of the point's move (docs/contact.md,
+      // node i moves by (w_i/m_i) / Σ_j (w_j²/m_j) times the point's move (docs/contact.md,
       // "Cells"), so a light border node is moved as far as its share of that force takes it.
       std::array<double, 3> inverse_mass{};
       for (std::size_t v = 0; v < 3; ++v)

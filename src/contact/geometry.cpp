@@ -459,9 +459,10 @@ Weights box_deepest(const Vec3& half, const Vec3& a, const Vec3& b, const Vec3& 
   // The signed distance is convex, so the candidates that tie for the deepest bound a set of
   // deepest points, and their mean is one of them. The mean of the distinct ones does not
   // depend on the order they were found in, which a mirror of the triangle and the box
-  // changes: taking the first found made the cube thrown into the net
-  // (scenes/contact/cube_net_500.toml) leave sideways when two ends of a cell's diagonal tied
-  // (tests/regression/test_contact_scenes.cpp).
+  // changes: taking the first found, the cube thrown into the net of
+  // scenes/contact/cube_net_500.toml left 5.6 cm to the side when two ends of a cell's
+  // diagonal tied under it (measured in a build without the cell pass's sweep; docs/contact.md,
+  // "Cells").
   std::array<double, 88> values{};
   double best_value = kInfinity;
   for (std::size_t i = 0; i < candidates.size(); ++i) {

@@ -731,7 +731,8 @@ void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
 // docs/contact.md, "Crinkles": a drape whose grid holds fewer than about two spacings per
 // bending length c = (6 xi / (mu0 g))^(1/3) (docs/materials.md) folds in creases one node wide,
 // a zig-zag at the grid's scale that no response removes; about 2.4 keeps folds smooth. Said
-// for scenes with solids, which are the drapes, once per axis that falls short.
+// for scenes with solids, which are the drapes, in one warning naming each axis that falls
+// short.
 void warn_if_folds_unresolved(const Origin& origin, Scene& scene) {
   const double g = norm(scene.gravity);
   if (scene.solids.empty() || g == 0.0) return;

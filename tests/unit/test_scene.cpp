@@ -1137,8 +1137,8 @@ TEST(SceneError, UnreadableFileIsNamed) {
 
 // docs/contact.md, "Crinkles": a drape whose grid holds fewer than two spacings per bending
 // length c = (6 xi / (mu0 g))^(1/3) is told that its folds will crease. Here mu0 = 0.1 kg/m^2
-// and xi = 2.5e-5 N m give c = (1.5e-4 / 0.981)^(1/3) = 5.35 cm against h = 10 cm / 9 along x1
-// and 5 cm / 11 along x2 (0.048 and 0.118 spacings); 1000 x 1200 nodes hold 5.3 and 12.8.
+// and xi = 2.5e-5 N m give c = (1.5e-4 / 0.981)^(1/3) = 5.35 cm against h = 10 m / 9 along x1
+// and 5 m / 11 along x2 (0.048 and 0.118 spacings); 1000 x 1200 nodes hold 5.3 and 12.8.
 TEST(Scene, DrapesWhoseGridIsCoarserThanTheirFoldsAreWarned) {
   SceneText text;
   text.top = "[environment]\ngravity = [0.0, -9.81, 0.0]\n";
