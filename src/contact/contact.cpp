@@ -29,6 +29,12 @@ constexpr int kCellSweeps = 1;
 
 constexpr double kHuge = std::numeric_limits<double>::infinity();
 
+// Whether any solid is bounded (not a plane): only those have a cell pass.
+bool any_bounded(const std::vector<SolidSpec>& solids) {
+  return std::any_of(solids.begin(), solids.end(),
+                     [](const SolidSpec& spec) { return spec.shape.kind != ShapeKind::plane; });
+}
+
 // What touched_ holds for a node: the response moved it; a free body was among the solids.
 constexpr unsigned char kTouched = 1;
 constexpr unsigned char kByFreeBody = 2;
@@ -305,9 +311,7 @@ Contact::Contact(const std::vector<SolidSpec>& solids, const Block& block, Halo&
         node_clear_[i].assign(static_cast<std::size_t>(block.owned_k()) * block.owned_l(),
                               -kHuge);
     }
-    if (std::any_of(solids.begin(), solids.end(),
-                    [](const SolidSpec& spec) { return spec.shape.kind != ShapeKind::plane; }))
-      node_sums_ = Field<Vec3>(block);
+    if (any_bounded(solids)) node_sums_ = Field<Vec3>(block);
     ready_.resize(tiles);
     exchange_rows_.resize(static_cast<std::size_t>(tiles_l_));
     push_rows_.resize(static_cast<std::size_t>(tiles_l_));
@@ -711,9 +715,7 @@ double Contact::memory_bytes(const Block& block, const std::vector<SolidSpec>& s
                   [](const SolidSpec& spec) { return spec.shape.kind == ShapeKind::plane; }))
     bytes += owned * (1.0 + sizeof(Vec3)) + ghosted * sizeof(Vec3);
   // With a bounded solid, the cell pass's node_sums_.
-  if (std::any_of(solids.begin(), solids.end(),
-                  [](const SolidSpec& spec) { return spec.shape.kind != ShapeKind::plane; }))
-    bytes += ghosted * sizeof(Vec3);
+  if (any_bounded(solids)) bytes += ghosted * sizeof(Vec3);
   for (const SolidSpec& spec : solids) {
     if (spec.motion != SolidMotion::fixed || spec.shape.kind == ShapeKind::plane) continue;
     bytes += cells * sizeof(double);
@@ -1587,15 +1589,25 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   // over its pressed triangles, first how many they are, then how far their shares lift it;
   // the owners sum theirs, and the exchange gives the ghosts theirs. Every rank exchanges as
   // often, pressed triangles or none.
-  const auto corners_of = [&](const CellPush& push) {
+  // A pushed triangle's cell (kc, lc), and its corners.
+  const auto cell_of = [&](const CellPush& push) {
     const auto cell = static_cast<int>(push.triangle / kCellTriangles);
-    return triangle_corners(cell % width + b.k0 - 2, cell / width + b.l0 - 2,
-                            static_cast<int>(push.triangle % kCellTriangles));
+    return std::array<int, 2>{cell % width + b.k0 - 2, cell / width + b.l0 - 2};
+  };
+  const auto corners_of = [&](const CellPush& push) {
+    const auto [kc, lc] = cell_of(push);
+    return triangle_corners(kc, lc, static_cast<int>(push.triangle % kCellTriangles));
   };
   for (const CellPush& push : cells_)
     for (const auto& [k, l] : corners_of(push))
       if (b.owns(k, l)) node_sums_(k, l).x += 1.0;
   halo_->exchange(node_sums_);
+  if (cells_.empty()) {
+    // The sweeps' exchanges, with nothing pressed here to send: the other ranks' sweeps need
+    // this rank's part of them.
+    for (int sweep = 0; sweep < kCellSweeps; ++sweep) halo_->exchange(node_sums_);
+    return;
+  }
   for (CellPush& push : cells_) {
     double most = 1.0;
     for (const auto& [k, l] : corners_of(push)) most = std::max(most, node_sums_(k, l).x);
@@ -1606,8 +1618,7 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   // The tiles holding a pushed triangle's owned nodes: only their nodes can have a push to sum.
   pushed_.assign(cells_near_.size(), 0);
   for (const CellPush& push : cells_) {
-    const auto cell = static_cast<int>(push.triangle / kCellTriangles);
-    const int kc = cell % width + b.k0 - 2, lc = cell / width + b.l0 - 2;
+    const auto [kc, lc] = cell_of(push);
     for (int v = 0; v < 4; ++v) {
       const int k = kc + (v & 1), l = lc + (v >> 1);
       if (b.owns(k, l)) pushed_[tile((k - b.k0) / kTile, (l - b.l0) / kTile)] = 1;
@@ -1653,7 +1664,6 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
             std::max(0.0, push.share + push.relaxation * (push.depth - lifted) / push.depth);
     }
   }
-  if (cells_.empty()) return;
 #pragma omp parallel for schedule(static)
   for (int j = 0; j < tiles_l_; ++j) {
     std::vector<Exchange>& exchanges = exchange_rows_[static_cast<std::size_t>(j)];
