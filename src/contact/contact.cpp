@@ -1284,9 +1284,28 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
   const double thickness = s.spec.thickness;
   const double curvature_radius = curved_radius(s.spec.shape);
   const double flat_offset = 0.5 * thickness;
-  const auto curved_offset = [&](double longest) {
-    if (longest > curvature_radius) return flat_offset;
-    const double sag = longest * longest / (8.0 * (curvature_radius + thickness));
+  // The sag, exactly: a triangle whose corners rest on the offset sphere of radius
+  // ρ = R + thickness lies in a plane that cuts it in a circle through them, and its deepest
+  // point is where the triangle comes nearest that circle's centre: ρ − √(ρ² − r²), r the
+  // radius of the smallest circle around the triangle (half the longest edge when the
+  // triangle is right or obtuse, its circumradius when acute). The approximation L²/8ρ
+  // fell short by L⁴/128ρ³ and the circumradius of a sheared, acute triangle was not in it:
+  // a triangle resting on a sphere was pressed by that much (1.6 µm on the 15 × 15 drape of
+  // tests/regression/test_contact_rest.cpp) and pushed its nodes off the surface every step,
+  // where friction could not hold them, and the drape gained energy while it crept.
+  const double offset_radius = curvature_radius + thickness;
+  const auto curved_offset = [&](const std::array<double, 3>& sides) {
+    std::array<double, 3> e = sides;
+    std::sort(e.begin(), e.end());
+    const auto [a, b2, c] = e;
+    double r = 0.5 * c;
+    if (a * a + b2 * b2 > c * c) {
+      // Heron's product in the order that keeps it accurate for a thin triangle (Kahan).
+      const double product = (c + (b2 + a)) * (a - (c - b2)) * (a + (c - b2)) * (c + (b2 - a));
+      if (product > 0.0) r = std::max(r, a * b2 * c / std::sqrt(product));
+    }
+    if (r >= offset_radius) return flat_offset;
+    const double sag = r * r / (offset_radius + std::sqrt((offset_radius - r) * (offset_radius + r)));
     return std::min(flat_offset, thickness - sag);
   };
   const double radius = g.bounding_radius();
@@ -1464,11 +1483,12 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
     for (int tri = 0; tri < kCellTriangles; ++tri) {
       const TriangleCorners nodes = triangle_corners(kc, lc, tri);
       double nearest = 1e300, longest = 0.0;
+      std::array<double, 3> sides{};
       for (int v = 0; v < 3; ++v) {
         nearest = std::min(nearest, distance_(nodes[v][0], nodes[v][1]));
-        longest = std::max(longest, edge[static_cast<std::size_t>(
-                                        kTriangleEdges[static_cast<std::size_t>(tri)]
-                                                      [static_cast<std::size_t>(v)])]);
+        sides[static_cast<std::size_t>(v)] = edge[static_cast<std::size_t>(
+            kTriangleEdges[static_cast<std::size_t>(tri)][static_cast<std::size_t>(v)])];
+        longest = std::max(longest, sides[static_cast<std::size_t>(v)]);
       }
       if (nearest - longest >= flat_offset) {
         found = std::min(found, nearest - longest);
@@ -1507,7 +1527,15 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       // not found.
       const bool curved = s.spec.motion != SolidMotion::free &&
                           (s.spec.shape.kind != ShapeKind::cylinder || c.normal.z == 0.0);
-      const double offset = curved ? curved_offset(longest) : flat_offset;
+      // A cylinder's side curves around its axis only: a triangle resting on it sags by the
+      // circle through its corners seen along the axis, the sides' lengths across it. A
+      // capsule keeps its sides as they are: a corner on a cap lies inside that circle.
+      if (curved && s.spec.shape.kind == ShapeKind::cylinder)
+        for (int v = 0; v < 3; ++v) {
+          const Vec3 d = p[static_cast<std::size_t>((v + 1) % 3)] - p[static_cast<std::size_t>(v)];
+          sides[static_cast<std::size_t>(v)] = std::sqrt(d.x * d.x + d.y * d.y);
+        }
+      const double offset = curved ? curved_offset(sides) : flat_offset;
       if (c.distance >= offset) continue;
       double depth = offset - c.distance;
       Vec3 side = c.normal;
