@@ -1,4 +1,4 @@
-// Throughput of one Verlet step with solids (CONTACT.md): the flat N x N sheet of bench_step
+// Throughput of one Verlet step with solids (docs/contact.md): the flat N x N sheet of bench_step
 // resting on what it meets, so that contact works on every step. Four cases:
 //   0  no solid (bench_step's step: what a scene without solids runs)
 //   1  one plane, the sheet lying on it: every node in contact on every step

@@ -240,7 +240,7 @@ std::optional<std::string> SemiImplicitSolver::solve(
   const double diagonal = 1.0 / (dt * dt) + terms.damping / (2.0 * dt);
 
   // [(1/Δt² + D/(2Δt)) I + F/(2Δt) n nᵀ − J]: the centred velocity terms of
-  // MODEL.md §4.
+  // docs/equations.md §4.
   check(MatScale(s.matrix, -1.0));
   check(MatShift(s.matrix, diagonal));
   if (terms.fluid > 0.0) {

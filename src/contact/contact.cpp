@@ -18,7 +18,7 @@ namespace cosserat {
 namespace {
 
 // Detection and response passes over the nodes and cells before a node still inside a solid
-// is left for the next step (CONTACT.md §2: a bounded number of repeats).
+// is left for the next step (docs/contact.md, "Detection": a bounded number of repeats).
 constexpr int kMaxPasses = 4;
 
 // Jacobi sweeps of the cell pass's shares (cell_pass; docs/contact.md, "Cells"). The round
@@ -117,8 +117,8 @@ Vec3 inertia_solve(const Quaternion& q, const Vec3& moments, const Vec3& x) {
   return rotate(q, local);
 }
 
-// CONTACT.md §3: the velocity a node leaves with, from its velocity v relative to a surface
-// moving at `surface`, with outward normal n: v_n' = −e v_n when approaching, Coulomb
+// docs/contact.md, "Response": the velocity a node leaves with, from its velocity v relative to a
+// surface moving at `surface`, with outward normal n: v_n' = −e v_n when approaching, Coulomb
 // friction |Δv_t| ≤ μ |Δv_n|, sticking when that suffices.
 [[gnu::always_inline]] inline Vec3 respond_velocity(const Vec3& v, const Vec3& surface,
                                                     const Vec3& n, double e, double mu) {
@@ -212,7 +212,8 @@ void widen_path(Vec3& lo, Vec3& hi, double& moved2, const Vec3& start, const Vec
 // (the frame's rotation), relative to the distances involved.
 constexpr double kBroadSlack = 1e-9;
 
-// The box holding a bounded shape in its own frame (CONTACT.md §1's shapes).
+// The box holding a bounded shape in its own frame (the shapes of docs/contact.md,
+// "Solids and their motion").
 std::pair<Vec3, Vec3> local_bounds(const Shape& shape) {
   const double r = shape.radius;
   switch (shape.kind) {
@@ -240,17 +241,18 @@ std::uint64_t solid_bit(std::size_t i) { return std::uint64_t{1} << std::min<std
 
 }  // namespace
 
-// One node's change of velocity by a free body in one phase of one pass (CONTACT.md §3): the
-// impulse J = m (v' − v), its moment r' × J about the origin, the moment m (r' − r) × v of the
-// node's move onto the surface, and the velocity v before. `key` orders the sums by (solid,
-// node, pass, phase), the same on every decomposition, with a node's changes next to each other.
+// One node's change of velocity by a free body in one phase of one pass (docs/contact.md,
+// "Free bodies"): the impulse J = m (v' − v), its moment r' × J about the origin, the moment
+// m (r' − r) × v of the node's move onto the surface, and the velocity v before. `key` orders
+// the sums by (solid, node, pass, phase), the same on every decomposition, with a node's
+// changes next to each other.
 struct Contact::Exchange {
   std::int64_t key;
   Vec3 impulse, moment, move_moment, velocity;
 };
 
 // A cell triangle pressed into a solid: its barycentric weights at the deepest point, the move
-// δ n of that point and the change of its velocity (CONTACT.md §2, "Between nodes").
+// δ n of that point and the change of its velocity (docs/contact.md, "Detection", "Cells").
 struct Contact::CellPush {
   std::size_t triangle = 0;  // its index among the block's: 4 (cell index) + 0 … 3
   std::array<double, 3> weights{};
@@ -385,10 +387,10 @@ void Contact::propose_free(Solid& s, double dt) const {
   s.proposed_pushing = s.pushing;
 }
 
-// CONTACT.md §3 at a point of solid s whose surface moves at `surface`, with world normal n,
-// for cloth moving at `velocity` there: the change against the solid's surface as if it could
-// not be moved. A free body's share is settled once all its contacts are known
-// (apply_impulses).
+// The response (docs/contact.md, "Response") at a point of solid s whose surface moves at
+// `surface`, with world normal n, for cloth moving at `velocity` there: the change against the
+// solid's surface as if it could not be moved. A free body's share is settled once all its
+// contacts are known (apply_impulses).
 Vec3 Contact::velocity_change(const Solid& s, const Vec3& surface, const Vec3& normal,
                               const Vec3& velocity) const {
   return respond_velocity(velocity, surface, normal, s.spec.restitution, s.spec.friction) -
@@ -1071,10 +1073,11 @@ void Contact::prepare(int i, int j, const Field<Vec3>& current, Field<Vec3>& nex
   ready_[t] = 1;
 }
 
-// CONTACT.md §2, nodes: the segment from the node at the start of the step to its proposed end,
-// each end in the solid's frame at its own time, against the solid inflated by `thickness`.
-// An end inside goes to the nearest point of the inflated surface; an end beyond a thin solid
-// the segment passed through goes back onto the tangent plane where the segment entered.
+// docs/contact.md, "Detection", nodes: the segment from the node at the start of the step to its
+// proposed end, each end in the solid's frame at its own time, against the solid inflated by
+// `thickness`. An end inside goes to the nearest point of the inflated surface; an end beyond a
+// thin solid the segment passed through goes back onto the tangent plane where the segment
+// entered.
 // The planes and then the other solids, each in scene order (order_), each seeing the node
 // where the ones before it put it. After a walk, the first pass's planes are done.
 void Contact::node_pass(int pass, const Field<Vec3>& current, Field<Vec3>& next,
@@ -1923,9 +1926,10 @@ ContactStats Contact::respond(double time, double dt, const Field<Vec3>& current
   return stats;
 }
 
-// CONTACT.md §3–§4. Each node met a free body as if it could not move, with impulse J_i; the
-// body and its nodes then share the impact as two bodies do: the nodes keep s J_i and the body
-// takes −s ΣJ_i, with one factor s for all its contacts. The kinetic energy changes by
+// docs/contact.md, "Free bodies" and "Parallel runs, restarts and output". Each node met a free
+// body as if it could not move, with impulse J_i; the body and its nodes then share the impact
+// as two bodies do: the nodes keep s J_i and the body takes −s ΣJ_i, with one factor s for all
+// its contacts. The kinetic energy changes by
 // ΔK(s) = s a + s² b, a = Σ J_i·(v_i − v_surface,i) < 0 for approaching nodes,
 // b = Σ|J_node|²/2m + |ΣJ|²/2M + T·I⁻¹T/2 with T = Σ (r_i − x) × J_i; s = (1 + e)/2 · (−a/b)
 // is the two-body impact with restitution e for a single contact, ΔK = s a (1 − e)/2 ≤ 0 for

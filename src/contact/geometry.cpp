@@ -1,5 +1,5 @@
-// The solids of CONTACT.md §1 in their own frames: closed forms for every shape but the mesh,
-// whose queries go through the CGAL tree of mesh_tree.cpp.
+// The solids of docs/contact.md, "Solids and their motion", in their own frames: closed forms for
+// every shape but the mesh, whose queries go through the CGAL tree of mesh_tree.cpp.
 
 #include "cosserat/contact/geometry.hpp"
 

@@ -1,5 +1,6 @@
-// Closest points and inside tests of a mesh solid through CGAL (CONTACT.md §1: a maintained
-// bounding-volume tree, not a hand-written search). The only file that includes CGAL.
+// Closest points and inside tests of a mesh solid through CGAL (docs/contact.md,
+// "Solids and their motion": a maintained bounding-volume tree, not a hand-written search). The
+// only file that includes CGAL.
 //
 // Kernel: exact predicates, inexact constructions. The inside test counts a ray's crossings of
 // the triangles; with plain doubles an orientation test near an edge or vertex can count one

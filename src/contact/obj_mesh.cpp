@@ -1,5 +1,6 @@
-// Reading a mesh solid from a Wavefront OBJ file (CONTACT.md §1). Kept free of CGAL and of the
-// rest of the contact module: the scene loader's fuzz targets compile this file alone.
+// Reading a mesh solid from a Wavefront OBJ file (docs/contact.md, "Solids and their motion"). Kept
+// free of CGAL and of the rest of the contact module: the scene loader's fuzz targets compile this
+// file alone.
 
 #include <algorithm>
 #include <array>

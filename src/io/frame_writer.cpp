@@ -132,8 +132,8 @@ std::vector<T> read_series(const hdf5::File& file, const Handle& dataset, hid_t 
   return values;
 }
 
-// --- Rigid solids (CONTACT.md §5): replicated on every rank, so rank 0 writes their data; the
-// creation and extension of their datasets is collective like every other's.
+// --- Rigid solids (docs/output.md, "HDF5"): replicated on every rank, so rank 0 writes their data;
+// the creation and extension of their datasets is collective like every other's.
 
 // One solid's frames: its pose and its surface placed by that pose.
 struct SolidSeries {

@@ -25,8 +25,9 @@ using geometry::Neighbours;
 // Stencil slot of the node (k + dk, l + dl) around p = (k, l).
 constexpr int slot(int dk, int dl) { return 3 * (dl + 1) + (dk + 1); }
 
-// Which terms of E_p exist (MODEL.md §2.5): §2.3 rule 1 leaves the shear terms (ε₁₂, κ₁₂) out
-// on the far borders, rule 2 leaves κ_αα out at nodes lacking an α-neighbour.
+// Which terms of E_p exist (docs/equations.md §2.5, "Nodal quadrature"): §2.3 rule 1 leaves the
+// shear terms (ε₁₂, κ₁₂) out on the far borders, rule 2 leaves κ_αα out at nodes lacking an
+// α-neighbour.
 struct Terms {
   bool shear, bend11, bend22;
 };

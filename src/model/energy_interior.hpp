@@ -1,9 +1,9 @@
 #pragma once
-// ∂E_p/∂r of MODEL.md §2.5 for an interior node p — all four neighbours present, so every term
-// of E_p exists (§2.3 rules 1–2 leave nothing out), the tangents are forward differences and
-// the cross derivative is X₊₊ — written without a branch so that a loop over a row of such
-// nodes vectorises. node_energy in cosserat_energy.cpp is the general form (any node, with
-// the energy itself); this is its interior case, and a unit test holds the two together.
+// ∂E_p/∂r of docs/equations.md §2.5 ("Nodal quadrature") for an interior node p — all four
+// neighbours present, so every term of E_p exists (§2.3 rules 1–2 leave nothing out), the tangents
+// are forward differences and the cross derivative is X₊₊ — written without a branch so that a loop
+// over a row of such nodes vectorises. node_energy in cosserat_energy.cpp is the general form (any
+// node, with the energy itself); this is its interior case, and a unit test holds the two together.
 //
 // An interior node's energy reads only its five-point cross and the node (k+1, l+1), so its
 // gradient has six nonzero stencil slots; the other three of node_energy's nine are zero.

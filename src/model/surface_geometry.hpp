@@ -1,7 +1,7 @@
 #pragma once
-// Per-node geometry of the discrete surface (MODEL.md §1 quantities, §2.1 stencils), one small
-// inline function per quantity, in MODEL.md's symbols. Private to the model module: the force
-// kernels compose these, so the arithmetic of a node is written once.
+// Per-node geometry of the discrete surface (docs/equations.md §1 quantities, §2.1 stencils), one
+// small inline function per quantity, in docs/equations.md's symbols. Private to the model module:
+// the force kernels compose these, so the arithmetic of a node is written once.
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/model/material.hpp"
@@ -10,7 +10,7 @@
 namespace cosserat::geometry {
 
 // Which grid neighbours of p exist: the border rules of §2.1 test the global index, never the
-// block edge (DESIGN.md principle 1).
+// block edge (docs/design.md, principle 1).
 struct Neighbours {
   bool left, right, down, up;  // p − e1, p + e1, p − e2, p + e2
   bool interior() const { return left && right && down && up; }

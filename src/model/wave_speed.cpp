@@ -6,7 +6,7 @@
 
 namespace cosserat {
 
-// Linearising MODEL.md §1 about the flat rest sheet (A_αβ = δ_αβ): Φ¹¹ = 3ζ₁₁,
+// Linearising docs/equations.md §1 about the flat rest sheet (A_αβ = δ_αβ): Φ¹¹ = 3ζ₁₁,
 // Φ¹² = ζ₁₂, so an in-plane displacement u obeys μ ü₁ = 6ζ₁₁ u₁,₁₁ + ζ₁₂ u₁,₂₂
 // + …, and a normal one μ ẅ = −6ξ₁₁ w,₁₁₁₁ − …. On the grid the highest mode
 // has wave number π/h, where the compact second difference is 4/h² and the

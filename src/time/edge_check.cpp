@@ -8,8 +8,8 @@
 namespace cosserat {
 
 namespace {
-// MODEL.md §4.2: the edge from a node moved by `a` to one moved by `b` changed by more than
-// the limit. Written so that a NaN also fails; an int, which the loops' reductions vectorise
+// docs/equations.md §4.2: the edge from a node moved by `a` to one moved by `b` changed by more
+// than the limit. Written so that a NaN also fails; an int, which the loops' reductions vectorise
 // (a bool does not, with g++ 12).
 inline int changed(double ax, double ay, double az, double bx, double by, double bz,
                    double limit2) {

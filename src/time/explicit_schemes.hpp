@@ -1,13 +1,13 @@
 #pragma once
-// The explicit schemes that carry velocities (MODEL.md §4), private to the time module: the
-// factory in scheme.cpp is the only place that names them.
+// The explicit schemes that carry velocities (docs/equations.md §4), private to the time module:
+// the factory in scheme.cpp is the only place that names them.
 
 #include "cosserat/time/scheme.hpp"
 
 namespace cosserat {
 
 // Solves (1 + c) w + d (n·w) n = rhs for w, |n| = 1, by Sherman–Morrison: the centred
-// damping and fluid terms of MODEL.md §4 in closed form.
+// damping and fluid terms of docs/equations.md §4 in closed form.
 inline Vec3 solve_centred(const Vec3& rhs, const Vec3& n, double c, double d) {
   return (rhs - (d / (1.0 + c + d) * dot(n, rhs)) * n) / (1.0 + c);
 }

@@ -112,15 +112,15 @@ void Stepper::restore(const Snapshot& s) {
   resume(s.step, s.time, s.last_dt);
 }
 
-// MODEL.md §4.2: a position that is not finite, or a node that moved more than half a grid
+// docs/equations.md §4.2: a position that is not finite, or a node that moved more than half a grid
 // spacing relative to a neighbour in one step: an edge of the grid changed by more than h/2.
-// MODEL.md compares each node's move with zero, which stops a sheet in fast rigid motion (S1
-// in free fall, at t = 57 s) though nothing in it deforms; the unstable modes of an explicit
-// step are the grid's highest, where neighbours move apart, and the relative move sees them
-// (at twice the size: neighbours move oppositely). Of an edge that changed too much, the end
-// that moved more is blamed (both ends on a tie); the first node blamed in (l, k) order is
-// reported, the same for any thread count and decomposition, since the ghosts of both states
-// are exchanged.
+// The published rule (docs/model.md, "Integrators") compares each node's move with zero, which
+// stops a sheet in fast rigid motion (S1 in free fall, at t = 57 s) though nothing in it deforms;
+// the unstable modes of an explicit step are the grid's highest, where neighbours move apart, and
+// the relative move sees them (at twice the size: neighbours move oppositely). Of an edge that
+// changed too much, the end that moved more is blamed (both ends on a tie); the first node blamed
+// in (l, k) order is reported, the same for any thread count and decomposition, since the ghosts of
+// both states are exchanged.
 std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_time) {
   const Block& b = *block_;
   const Field<Vec3>& r = scheme_->positions();

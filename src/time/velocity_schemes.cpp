@@ -1,5 +1,5 @@
-// The schemes that carry velocities (MODEL.md §4): leapfrog, the two Euler schemes, midpoint,
-// RK4 and velocity-verlet.
+// The schemes that carry velocities (docs/equations.md §4): leapfrog, the two Euler schemes,
+// midpoint, RK4 and velocity-verlet.
 
 #include "explicit_schemes.hpp"
 

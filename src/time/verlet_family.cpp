@@ -13,7 +13,7 @@ VerletFamily::VerletFamily(const StepContext& context, const Field<Vec3>& positi
       velocity_report_(context.block) {}
 
 // The second-order start r⁻ = r − Δt v + ½Δt² a; verlet-lagged keeps the published first-order
-// one (MODEL.md §4).
+// one (docs/equations.md §4).
 void VerletFamily::start(Field<Vec3> velocities) {
   const double dt = context_.dt;
   if (published_) {
@@ -46,8 +46,8 @@ std::optional<std::string> VerletFamily::propose(long step) {
 }
 
 // verlet and tc-verlet: r⁺ = r + (r − r⁻) Δtₙ/Δtₙ₋₁ + Δtₙ (Δtₙ + Δtₙ₋₁)/2 a, the form that is
-// consistent on a non-uniform time grid (MODEL.md §4 publishes Δtₙ² a, first order when the
-// step changes; docs/stability.md), with the velocity terms at the centre,
+// consistent on a non-uniform time grid (the published form, docs/equations.md §4, has Δtₙ² a,
+// first order when the step changes; docs/stability.md), with the velocity terms at the centre,
 // v = (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁), solved in closed form. With a constant step both are the plain
 // central-difference Verlet, bit for bit: (Δt + Δt)/2 is Δt exactly.
 void VerletFamily::centred_step(long step) {
@@ -114,7 +114,7 @@ void VerletFamily::centred_step(long step) {
   context_.constraints.hold_positions(next_positions_, context_.end_time);
 }
 
-// The published Verlet: velocity terms lagged, v = (r − r⁻)/Δt; first order (MODEL.md §4).
+// The published Verlet: velocity terms lagged, v = (r − r⁻)/Δt; first order (docs/equations.md §4).
 void VerletFamily::lagged_step(long step) {
   context_.constraints.hold_positions(previous_positions_, previous_time(dt_previous_));
   const double dt = context_.dt;

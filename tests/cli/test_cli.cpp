@@ -1,4 +1,4 @@
-// The `cosserat` command line as a user meets it (DESIGN.md "Interfaces"): exit statuses,
+// The `cosserat` command line as a user meets it (docs/design.md, "Interfaces"): exit statuses,
 // messages, what a failed run leaves behind. Runs the real executable in a child process.
 
 #include <gmock/gmock.h>

@@ -155,10 +155,10 @@ inline Scene gusty_rolling_back_scene(Integrator integrator) {
   return scene;
 }
 
-// Contact with a free body (CONTACT.md §4): a 13 x 11 sheet held at two corners, a free box
-// thrown down onto it off-centre and spinning, a fixed sphere under the sheet whose cells it
-// presses into, and a floor; 160 steps of 1 ms, long enough for both solids to touch the
-// sheet across the block borders of every split.
+// Contact with a free body (docs/contact.md, "Parallel runs, restarts and output"): a 13 x 11 sheet
+// held at two corners, a free box thrown down onto it off-centre and spinning, a fixed sphere under
+// the sheet whose cells it presses into, and a floor; 160 steps of 1 ms, long enough for both
+// solids to touch the sheet across the block borders of every split.
 // A soft, light sheet of m x n nodes and size1 x size2 m in the plane y = origin.y, under
 // gravity along −y: what the contact scenes below drop onto their solids.
 inline Scene soft_sheet(int m, int n, double size1, double size2, const Vec3& origin) {

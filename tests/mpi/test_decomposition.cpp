@@ -1,8 +1,8 @@
-// MODEL.md §5 item 8 under mpiexec: P ranks, every split of the grid over them, give the
+// docs/equations.md §5 item 8 under mpiexec: P ranks, every split of the grid over them, give the
 // forces and the trajectory of one block. Each rank also runs the one-block reference itself
 // (on MPI_COMM_SELF; the grids are small) and compares its own nodes with it. The total area is
-// summed in integers (QuantizedSum), so the match asserted is bitwise, stronger than MODEL's
-// "to round-off".
+// summed in integers (QuantizedSum), so the match asserted is bitwise, stronger than that
+// item's "to round-off".
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -269,9 +269,9 @@ TEST(DecompositionInvariance, AdaptiveStepsAndTheirRollBacksFollowTheOneBlockRun
   }
 }
 
-// Contact with a free body (CONTACT.md §4): contacts on owned nodes and cells, the body's
-// impulse sums in one global order, so the cloth and the body follow the one-block run bitwise
-// on every split, for a scheme of each state kind.
+// Contact with a free body (docs/contact.md, "Parallel runs, restarts and output"): contacts on
+// owned nodes and cells, the body's impulse sums in one global order, so the cloth and the body
+// follow the one-block run bitwise on every split, for a scheme of each state kind.
 TEST(DecompositionInvariance, ContactWithAFreeBodyFollowsTheOneBlockRun) {
   for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
     const Scene scene = testing::free_body_scene(integrator);

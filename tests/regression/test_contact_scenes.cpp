@@ -1,6 +1,6 @@
-// The contact scenes of scenes/contact end to end (CONTACT.md §6), each for as long as it takes
-// its solids to meet the cloth: no node ends a step deeper than a tolerance inside a solid, and
-// the run's max_penetration, which the summary reports, says so.
+// The contact scenes of scenes/contact end to end (docs/contact.md, "Scenes"), each for as long as
+// it takes its solids to meet the cloth: no node ends a step deeper than a tolerance inside a
+// solid, and the run's max_penetration, which the summary reports, says so.
 
 #include <gtest/gtest.h>
 

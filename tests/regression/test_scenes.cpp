@@ -1,4 +1,5 @@
-// The reference scenes end to end, as shipped in scenes/ (SCENES.md, MODEL.md §5 item 5).
+// The reference scenes end to end, as shipped in scenes/ (docs/scenes.md,
+// docs/equations.md §5 item 5).
 
 #include <gtest/gtest.h>
 
@@ -15,7 +16,7 @@ std::string scene_file(const std::string& name) {
 }
 
 // S1 at its default Δt: stable for all 10 000 steps, settles (kinetic energy below 1e-3 of
-// its peak) and keeps its area within 10 % (SCENES.md "What to record").
+// its peak) and keeps its area within 10 % (docs/scenes.md, "S1–S6: the integrator study").
 TEST(Clothesline, StableSettlesAndKeepsItsArea) {
   const Scene scene = load_scene(scene_file("s1_clothesline.toml"));
   Simulation sim(scene, MPI_COMM_SELF);
@@ -90,9 +91,9 @@ TEST(Fold, SheetOverAHeldLineRunsThrough) {
   EXPECT_LT(sim.diagnostics().center_of_mass.y, -1.0);
 }
 
-// The hard case that motivated the energy form (MODEL.md §2.5): S2 with the silk preset, which
-// the flux form stops at t ≈ 2.3 s whatever the step, runs its 10 s in the energy form, and its
-// total energy (kinetic + elastic + gravitational) never rises above where it started: damping
+// The hard case that motivated the energy form (docs/equations.md §2.5): S2 with the silk preset,
+// which the flux form stops at t ≈ 2.3 s whatever the step, runs its 10 s in the energy form, and
+// its total energy (kinetic + elastic + gravitational) never rises above where it started: damping
 // only takes energy out, the discretisation feeds none in.
 TEST(HardCases, SilkCapeHoldsInTheEnergyForm) {
   Scene scene = load_scene(scene_file("s2_cape.toml"),

@@ -1,5 +1,6 @@
 #pragma once
-// Scenes built in code for tests: a flat sheet with the SCENES.md defaults, to be varied.
+// Scenes built in code for tests: a flat sheet with the reference sheet's defaults
+// (docs/scenes.md), to be varied.
 
 #include <gtest/gtest.h>
 
@@ -21,7 +22,8 @@ class Silent : public StepObserver {
   void progress(long) override {}
 };
 
-// m x n sheet, 10 m x 10 m in the xz plane, SCENES.md default material, no terms at all.
+// m x n sheet, 10 m x 10 m in the xz plane, the reference sheet's material (docs/scenes.md), no
+// terms at all.
 inline Scene flat_sheet(int m, int n) {
   Scene s;
   s.name = "test";

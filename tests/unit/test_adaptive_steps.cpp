@@ -251,10 +251,11 @@ TEST(AdaptiveSteps, BelowTheSmallestStepTheRunIsUnstable) {
 }
 
 // Verlet with a varying step takes r⁺ = r + (r − r⁻) Δt/Δt₋ + a Δt (Δt + Δt₋)/2, the form that
-// is consistent on a non-uniform time grid (MODEL.md §4 publishes a Δt², first order when the
-// step changes). Random steps between 0.5 and 1.5 of a mean Δt, the same pattern at Δt, Δt/2
-// and Δt/4, against a fixed step 64 times finer: the error falls about four times per halving
-// (measured 1.86e-5, 5.86e-6, 1.25e-6 m: ratios 3.2 and 4.7; first order would give 2).
+// is consistent on a non-uniform time grid (the published form, docs/equations.md §4, has a Δt²,
+// first order when the step changes). Random steps between 0.5 and 1.5 of a mean Δt, the same
+// pattern at Δt, Δt/2 and Δt/4, against a fixed step 64 times finer: the error falls about four
+// times per halving (measured 1.86e-5, 5.86e-6, 1.25e-6 m: ratios 3.2 and 4.7; first order
+// would give 2).
 TEST(AdaptiveSteps, VerletOnRandomStepsIsSecondOrder) {
   Scene scene = testing::flat_sheet(6, 5);
   scene.gravity = {0.0, -9.8, 0.0};

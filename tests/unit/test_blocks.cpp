@@ -1,5 +1,5 @@
-// MODEL.md §2.4: the force at a node depends only on positions within two nodes of it, so a
-// block that holds its owned nodes plus two ghost rings computes exactly the forces the whole
+// docs/equations.md §2.4: the force at a node depends only on positions within two nodes of it, so
+// a block that holds its owned nodes plus two ghost rings computes exactly the forces the whole
 // grid does. Checked here for several splits inside one process (the MPI halo exchange that
 // fills real ghosts comes with the decomposition); every block's forces must be bitwise those
 // of the single block.

@@ -1,4 +1,4 @@
-// Fixed nodes, axis masks, step windows and point loads (MODEL.md §1 and §4.1).
+// Fixed nodes, axis masks, step windows and point loads (docs/equations.md §1 and §4.1).
 
 #include <gtest/gtest.h>
 

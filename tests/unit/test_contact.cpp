@@ -1,6 +1,6 @@
-// Cloth against rigid solids (CONTACT.md §2–§3): each test checks a law the response must
-// keep — no node inside a solid, Coulomb's law on an incline, restitution, momentum exchange
-// with a free body, symmetry, no tunnelling — on small sheets built in code.
+// Cloth against rigid solids (docs/contact.md, "Detection" and "Response"): each test checks a law
+// the response must keep — no node inside a solid, Coulomb's law on an incline, restitution,
+// momentum exchange with a free body, symmetry, no tunnelling — on small sheets built in code.
 
 #include <gtest/gtest.h>
 
@@ -65,9 +65,9 @@ Vec3 mean_position(const Simulation& sim) {
   return sum / (static_cast<double>(b.m) * b.n);
 }
 
-// Coulomb (CONTACT.md §3): on a plane tilted by θ a sheet stays put when tan θ < μ and slides
-// with acceleration g (sin θ − μ cos θ) when tan θ > μ. The plane is y = 0; gravity is tilted
-// instead, so the sheet's slide is along x.
+// Coulomb (docs/contact.md, "Response"): on a plane tilted by θ a sheet stays put when tan θ < μ
+// and slides with acceleration g (sin θ − μ cos θ) when tan θ > μ. The plane is y = 0; gravity is
+// tilted instead, so the sheet's slide is along x.
 double slide_acceleration(double theta, double mu, double* drift_when_stuck, long steps = 500,
                           Integrator integrator = Integrator::verlet) {
   const double g = 9.81;
@@ -308,8 +308,8 @@ TEST(Contact, StaticFrictionHoldsForTenSeconds) {
   }
 }
 
-// Restitution (CONTACT.md §3): a flat sheet without stiffness dropped from height H onto a
-// frictionless plane rebounds to H with e = 1 (to the step's accuracy) and stays down with
+// Restitution (docs/contact.md, "Response"): a flat sheet without stiffness dropped from height H
+// onto a frictionless plane rebounds to H with e = 1 (to the step's accuracy) and stays down with
 // e = 0.
 double rebound_height(Integrator integrator, double restitution, double dt) {
   const double drop = 0.5;
@@ -352,8 +352,8 @@ TEST(Contact, ElasticReboundReachesTheDropHeightAndInelasticStaysDown) {
   }
 }
 
-// Tunnelling (CONTACT.md §2): a sheet at 50 m/s meets a plane of zero thickness 2 cm below
-// it, 5 cm per step: continuous detection stops it at the plane.
+// Tunnelling (docs/contact.md, "Detection"): a sheet at 50 m/s meets a plane of zero thickness 2 cm
+// below it, 5 cm per step: continuous detection stops it at the plane.
 TEST(Contact, AFastSheetDoesNotPassThroughAThinPlane) {
   Scene scene = sheet_at(6, 0.5, 0.02);
   scene.initial_velocity = {0.0, -50.0, 0.0};
@@ -389,8 +389,8 @@ double distance_to_triangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 }
 
 // A sphere far smaller than the grid spacing under the middle of a cell: no node ever touches
-// it, so only the cell test (CONTACT.md §2, between nodes) can carry the sheet; without it the
-// sheet falls past (0.7 m in 0.4 s).
+// it, so only the cell test (docs/contact.md, "Detection", "Cells") can carry the sheet; without it
+// the sheet falls past (0.7 m in 0.4 s).
 TEST(Contact, ASphereSmallerThanACellCarriesTheSheet) {
   Scene scene = sheet_at(6, 1.0, 0.1);  // h = 0.2 m; cell (2, 2) spans x, z in [−0.1, 0.1]
   scene.gravity = {0.0, -9.81, 0.0};
@@ -414,8 +414,8 @@ TEST(Contact, ASphereSmallerThanACellCarriesTheSheet) {
     for (int k = 2; k < 4; ++k) EXPECT_GT(sim.positions()(k, l).y, -0.1) << k << ", " << l;
 }
 
-// Momentum (CONTACT.md §3): without gravity or held nodes, a free sphere hitting a free sheet
-// off-centre leaves the total linear and angular momentum of cloth and body unchanged to
+// Momentum (docs/contact.md, "Free bodies"): without gravity or held nodes, a free sphere hitting a
+// free sheet off-centre leaves the total linear and angular momentum of cloth and body unchanged to
 // round-off, and the kinetic energy never grows.
 TEST(Contact, AFreeBodyAndTheSheetExchangeMomentumExactly) {
   Scene scene = sheet_at(9, 1.0, 0.0);
@@ -472,9 +472,9 @@ TEST(Contact, AFreeBodyAndTheSheetExchangeMomentumExactly) {
   EXPECT_GT(contacts, 0) << "the sphere never reached the sheet";
 }
 
-// Symmetry (CONTACT.md §6.3): a cube driven into a net held at its corners, centred and
-// square to it. The energy and the cells' triangles keep every mirror of the grid
-// (docs/contact.md, "Symmetry"), here x → −x, z → −z and x ↔ z, and the contact response keeps
+// Symmetry (the cube net of docs/contact.md, "Scenes"): a cube driven into a net held at its
+// corners, centred and square to it. The energy and the cells' triangles keep every mirror of the
+// grid (docs/contact.md, "Symmetry"), here x → −x, z → −z and x ↔ z, and the contact response keeps
 // them too: the cube's offset from the plane x = z stays at round-off through its flight and
 // the impact, where a body that did not exchange angular momentum with the cloth would be
 // turned and sent aside. On this coarse net (h = 0.45 m, about the cube's edge) round-off

@@ -1,6 +1,7 @@
-// Geometry of rigid solids (CONTACT.md §1–§2): every query checked against an independent
-// construction (brute force over a sampled surface or segment, inside tests by inequalities,
-// Monte Carlo integrals), not against numbers the implementation produced.
+// Geometry of rigid solids (docs/contact.md, "Solids and their motion" and "Detection"): every
+// query checked against an independent construction (brute force over a sampled surface or segment,
+// inside tests by inequalities, Monte Carlo integrals), not against numbers the implementation
+// produced.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
-// The stability check's edge test (MODEL.md §4.2) flags exactly the rows that hold a node with
-// an edge that changed too much, whether a scheme's row walk tested most edges while its rows
+// The stability check's edge test (docs/equations.md §4.2) flags exactly the rows that hold a node
+// with an edge that changed too much, whether a scheme's row walk tested most edges while its rows
 // were in cache or the check tested them all in its own pass: the check then scans only those
 // rows, so a row missed would be a failure missed.
 

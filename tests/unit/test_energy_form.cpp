@@ -394,8 +394,8 @@ TEST(EnergyForm, JacobianIsSymmetric) {
   }
 }
 
-// MODEL.md §5 item 1 for the energy form: a rotated and translated rest sheet stores no energy
-// and feels no force.
+// docs/equations.md §5 item 1 for the energy form: a rotated and translated rest sheet stores no
+// energy and feels no force.
 TEST(EnergyForm, RigidMotionHasNoEnergyAndNoForce) {
   for (const Quadrature q : kQuadratures) {
   SCOPED_TRACE(name(q));

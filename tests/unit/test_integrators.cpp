@@ -1,4 +1,4 @@
-// MODEL.md §5 items 2 (free fall) and 7 (convergence order of every scheme, damping on).
+// docs/equations.md §5 items 2 (free fall) and 7 (convergence order of every scheme, damping on).
 
 #include <gtest/gtest.h>
 

@@ -325,7 +325,7 @@ TEST_F(FrameWriterTest, UnwritablePathNamesTheFile) {
   }
 }
 
-// --- Rigid solids (CONTACT.md §5) ---
+// --- Rigid solids (docs/output.md, "HDF5") ---
 
 // A box of half extents (a, b, c): 8 corners, 2 triangles a face.
 TriangleMesh box_surface(double a, double b, double c) {
@@ -741,8 +741,8 @@ RunSummary example_summary() {
   return summary;
 }
 
-// DESIGN.md's keys, in its order, with the decomposition and halo time of issue 3 added, and
-// the contact figures (null and empty without solids).
+// The keys of docs/output.md, "Run summary", in its order, with the decomposition and halo time of
+// issue 3 added, and the contact figures (null and empty without solids).
 TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
   const std::string json = to_json(example_summary());
   const std::regex key(R"re(\n  "(\w+)":)re");

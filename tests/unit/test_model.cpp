@@ -1,4 +1,5 @@
-// MODEL.md §5 items 1, 3 and 4, and momentum conservation of the flux-form divergence (§2.2).
+// docs/equations.md §5 items 1, 3 and 4, and momentum conservation of the flux-form
+// divergence (§2.2).
 
 #include <gtest/gtest.h>
 
@@ -150,10 +151,10 @@ RestSpectrum rest_spectrum(const Scene& scene, const std::vector<bool>& clamped)
 }
 
 
-// §5.4: no growing modes. 12 x 12 sheet, h ≈ 0.9 m, SCENES.md default material. The largest
-// Re √λ is printed for the note; with the symmetric border rules it must be far below the
-// damping rate ϱ_D/μ = 2 s⁻¹ of the scenes (we require < 1 % of it), and J symmetric to
-// finite-difference noise (MODEL.md §2.3).
+// §5.4: no growing modes. 12 x 12 sheet, h ≈ 0.9 m, the reference sheet's material
+// (docs/scenes.md). The largest Re √λ is printed for the note; with the symmetric border rules it
+// must be far below the damping rate ϱ_D/μ = 2 s⁻¹ of the scenes (we require < 1 % of it), and J
+// symmetric to finite-difference noise (docs/equations.md §2.3).
 TEST(GrowingModes, SymmetricBordersHaveNone) {
   for (const bool clamp : {false, true}) {
     Scene scene = flat_sheet(12, 12);
@@ -169,8 +170,9 @@ TEST(GrowingModes, SymmetricBordersHaveNone) {
   }
 }
 
-// The published border rules are kept selectable; they do have growing modes (MODEL.md §2.3
-// reports about 0.3 s⁻¹ on this sheet), which is why they are not the default.
+// The published border rules are kept selectable; they do have growing modes
+// (docs/equations.md §2.3 reports about 0.3 s⁻¹ on this sheet), which is why they are not the
+// default.
 TEST(GrowingModes, PublishedBordersHaveGrowingModes) {
   Scene scene = flat_sheet(12, 12);
   scene.borders = Borders::published;

@@ -1,4 +1,4 @@
-// Scene loader (shared/spec/SCENE_FORMAT.md): valid scenes give the right values and defaults;
+// Scene loader (docs/scene-format.md): valid scenes give the right values and defaults;
 // every bad input is one SceneError naming the file, the key and what is allowed.
 
 #include <gmock/gmock.h>

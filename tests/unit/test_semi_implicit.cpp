@@ -38,7 +38,7 @@ Scene busy_sheet(Integrator scheme) {
 }
 
 // With J = 0 the step is explicit Verlet with the velocity terms at the centre
-// (MODEL.md §4). A sheet without stiffness has f_int = 0 and so J = 0 exactly:
+// (docs/equations.md §4). A sheet without stiffness has f_int = 0 and so J = 0 exactly:
 // the two schemes must agree to the linear solver's tolerance with damping,
 // fluid, a load and held components all on.
 TEST(SemiImplicit, WithoutStiffnessItIsVerlet) {
@@ -100,9 +100,9 @@ TEST(SemiImplicit, MovingHeldComponentsFollowTheirVelocity) {
   EXPECT_LT(norm(sim.velocities()(8, 6) - Vec3{0.1, -0.2, 0.05}), 1e-9);
 }
 
-// The point of the baseline: S1 (SCENES.md) at three times the CFL estimate (0.0133 s; 3.2 times
-// Verlet's limit of 0.0124 s measured by `cosserat stable-dt`) runs stably for 3 s, where Verlet
-// is stopped by the monitor. The Jacobian must be right for this, not just present.
+// The point of the baseline: S1 (docs/scenes.md) at three times the CFL estimate (0.0133 s; 3.2
+// times Verlet's limit of 0.0124 s measured by `cosserat stable-dt`) runs stably for 3 s, where
+// Verlet is stopped by the monitor. The Jacobian must be right for this, not just present.
 TEST(SemiImplicit, StableBeyondTheExplicitLimit) {
   Scene scene = load_scene(std::string(COSSERAT_SOURCE_DIR) + "/scenes/s1_clothesline.toml");
   scene.dt = 3.0 * cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2()).dt;

@@ -79,7 +79,7 @@ TEST(SurfaceMeasures, ACylinderHasHalfItsCurvatureAsMeanCurvature) {
 }
 
 // The density times the rest area of a node is its share of the stored energy the summary
-// reports (MODEL.md §2.5), border nodes' left-out terms included.
+// reports (docs/equations.md §2.5), border nodes' left-out terms included.
 TEST(SurfaceMeasures, EnergyDensityAddsUpToTheStoredEnergy) {
   Scene scene = testing::flat_sheet(9, 7);
   scene.size2 = 8.0;

@@ -1,4 +1,4 @@
-// MODEL.md §5 item 6: a scene symmetric under a mirror of the grid stays symmetric.
+// docs/equations.md §5 item 6: a scene symmetric under a mirror of the grid stays symmetric.
 
 #include <gtest/gtest.h>
 

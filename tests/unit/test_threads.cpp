@@ -1,4 +1,4 @@
-// DESIGN.md principle 5: the same inputs give bitwise the same trajectory for any thread
+// docs/design.md, principle 5: the same inputs give bitwise the same trajectory for any thread
 // count (reductions run in a fixed order, each node's update is independent).
 
 #include <gtest/gtest.h>

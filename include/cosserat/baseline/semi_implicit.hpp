@@ -1,12 +1,12 @@
 #pragma once
-// The PETSc semi-implicit baseline (DESIGN.md module `baseline`): the linear
+// The PETSc semi-implicit baseline (docs/design.md, "Modules": `baseline`): the linear
 // system of the linearly implicit central-difference step, per unit mass
 // (docs/semi-implicit.md),
 //
 //   [(1/Δt² + D/(2Δt)) I + F/(2Δt) n nᵀ − J] δ = b,   J = ∂(f_int/μ)/∂r at rⁿ,
 //
 // D = ϱ_D/μ and F = ϱ_R/μ the velocity terms taken at the step's centre, as the
-// explicit Verlet does (MODEL.md §4). J comes from the explicit schemes' own
+// explicit Verlet does (docs/equations.md §4). J comes from the explicit schemes' own
 // force kernel by coloured finite differences on a DMDA laid over the same
 // decomposition; held components are eliminated; KSP solves. Without PETSc the
 // scene loader refuses the integrator, and any_scheme builds the explicit ones.

@@ -1,5 +1,6 @@
 #pragma once
-// Cloth against rigid solids (CONTACT.md §2–§4): the solids of a scene, their motion, and the
+// Cloth against rigid solids (docs/contact.md, "Detection", "Response" and
+// "Parallel runs, restarts and output"): the solids of a scene, their motion, and the
 // detection and response applied to a proposed step. Works on this rank's block: contacts on
 // owned nodes and owned cells, the free bodies' impulse sums exact and independent of the
 // decomposition, so every rank moves every body identically.
@@ -163,9 +164,9 @@ class Contact {
   // Every solid's state at time + dt and what the broad phase needs of it.
   void propose(double time, double dt);
   // A plane met by a node whose proposed end is r, moving at v, with `scheme_offset`
-  // (slip_correction): r goes onto its offset surface and v takes the response (CONTACT.md
-  // §3), `surface` the plane's velocity there. False, and nothing changed, when r is clear of
-  // it.
+  // (slip_correction): r goes onto its offset surface and v takes the response (docs/contact.md,
+  // "Response"), `surface` the plane's velocity there. False, and nothing changed, when r is clear
+  // of it.
   [[gnu::always_inline]] inline bool meet_plane(const Solid& s, Vec3& r, Vec3& v, Vec3& surface,
                                                 const Vec3& scheme_offset) const;
   // The planes for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.

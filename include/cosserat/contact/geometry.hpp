@@ -1,6 +1,7 @@
 #pragma once
-// Rigid shapes in their own frame and the rigid motions that place them (CONTACT.md §1–§2):
-// the geometric queries contact detection needs, nothing about time or response.
+// Rigid shapes in their own frame and the rigid motions that place them (docs/contact.md,
+// "Solids and their motion" and "Detection"): the geometric queries contact detection needs,
+// nothing about time or response.
 
 #include <array>
 #include <limits>
@@ -107,10 +108,10 @@ class SolidGeometry {
     return closest_other(p);
   }
 
-  // Continuous detection (CONTACT.md §2): the smallest t in [0, 1] at which a + t (b − a)
-  // is within `offset` of the shape (t = 0 when a already is), or nothing. "Within" to
-  // kContactTolerance times the larger of |b − a| and the offset: far below any response's
-  // own error, and reached in a few Newton steps.
+  // Continuous detection (docs/contact.md, "Detection"): the smallest t in [0, 1] at which
+  // a + t (b − a) is within `offset` of the shape (t = 0 when a already is), or nothing.
+  // "Within" to kContactTolerance times the larger of |b − a| and the offset: far below any
+  // response's own error, and reached in a few Newton steps.
   static constexpr double kContactTolerance = 1e-7;
   std::optional<double> first_contact(const Vec3& a, const Vec3& b, double offset) const;
 

@@ -1,6 +1,7 @@
 #pragma once
-// A rigid solid as a scene describes it (CONTACT.md §1, docs/scene-format.md "[[solid]]"):
-// its shape and where it starts, how it moves, and how cloth meets it.
+// A rigid solid as a scene describes it (docs/contact.md, "Solids and their motion";
+// docs/scene-format.md, "Solids"): its shape and where it starts, how it moves, and how cloth
+// meets it.
 
 #include <optional>
 #include <string>

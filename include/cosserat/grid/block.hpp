@@ -1,7 +1,7 @@
 #pragma once
 // The local block of the global m x n grid that one rank owns, with ghost layers around it
-// (DESIGN.md principle 1). Every loop in the solver runs over global indices (k, l) inside the
-// block's owned range, so the same code serves one rank and many; physical-border rules test
+// (docs/design.md, principle 1). Every loop in the solver runs over global indices (k, l) inside
+// the block's owned range, so the same code serves one rank and many; physical-border rules test
 // the global index, never the block edge.
 
 #include <mpi.h>
@@ -28,7 +28,7 @@ inline int size_of(MPI_Comm comm) {
   return size;
 }
 
-// Ghost width: a node's force reads positions up to two nodes away (MODEL.md §2.4; the
+// Ghost width: a node's force reads positions up to two nodes away (docs/equations.md §2.4; the
 // derivation is next to the kernel in model/cosserat_model.cpp).
 inline constexpr int kGhostWidth = 2;
 

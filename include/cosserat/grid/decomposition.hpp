@@ -1,5 +1,5 @@
 #pragma once
-// The 2D Cartesian split of the m x n grid over the ranks of a communicator (DESIGN.md
+// The 2D Cartesian split of the m x n grid over the ranks of a communicator (docs/design.md,
 // principle 1): parts_k blocks along x1 (k) times parts_l along x2 (l), uneven by at most one
 // node, rank = i + parts_k j for the block (i, j).
 

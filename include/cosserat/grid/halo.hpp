@@ -1,7 +1,7 @@
 #pragma once
-// Halo exchange of a block's ghost rings with the up to eight neighbouring blocks (DESIGN.md
-// principle 1). Width kGhostWidth = 2, the reach of the force stencil (MODEL.md §2.4, derived
-// in model/cosserat_model.cpp): a node's force reads positions up to two nodes away along
+// Halo exchange of a block's ghost rings with the up to eight neighbouring blocks (docs/design.md,
+// principle 1). Width kGhostWidth = 2, the reach of the force stencil (docs/equations.md §2.4,
+// derived in model/cosserat_model.cpp): a node's force reads positions up to two nodes away along
 // each axis and diagonally (the box stencil), so the corner blocks are neighbours too. The
 // intermediates (resultants, tractions) are recomputed on the ring rather than exchanged, so
 // one exchange of positions per force evaluation is all the kernel needs. Ghosts outside the

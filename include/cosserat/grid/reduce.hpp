@@ -1,5 +1,5 @@
 #pragma once
-// Global reductions with a fixed summation order, so a run repeats bitwise (DESIGN.md
+// Global reductions with a fixed summation order, so a run repeats bitwise (docs/design.md,
 // principle 5): every rank's partial is gathered and summed in rank order on every rank.
 
 #include <mpi.h>
@@ -14,7 +14,7 @@ double global_max(double local, MPI_Comm comm);
 // A sum of non-negative doubles counted in integer multiples of a quantum. Integer addition is
 // associative, so the total is the same bitwise whatever the order of the terms: the same for
 // any decomposition and thread count, not only for a given one. Used for the total area S,
-// which enters the trajectory (MODEL.md §3), so that P ranks follow one rank's trajectory
+// which enters the trajectory (docs/equations.md §3), so that P ranks follow one rank's trajectory
 // bitwise. Each term is rounded to the nearest quantum; a term that is not finite or too
 // large for 62 bits makes the total NaN.
 class QuantizedSum {

@@ -1,11 +1,11 @@
 #pragma once
-// The HDF5 output of a run (shared/spec/SCENE_FORMAT.md, "Output"): one frame of positions per
+// The HDF5 output of a run (docs/output.md, "HDF5"): one frame of positions per
 // write_frame, written collectively by every rank as its block's hyperslab (parallel HDF5),
 // appended and flushed at once, and named in the XDMF file beside it by rank 0 (one element
 // appended per frame, xdmf.hpp), so that a killed run leaves both files readable with every
-// frame written so far. The rigid solids of a contact scene (CONTACT.md §5) are written beside
-// the cloth, from plain data (SolidOutline, Pose), by rank 0; per-node fields (NodeField) like
-// the positions, each rank its block.
+// frame written so far. The rigid solids of a contact scene (`/solids`, same section) are written
+// beside the cloth, from plain data (SolidOutline, Pose), by rank 0; per-node fields (NodeField)
+// like the positions, each rank its block.
 
 #include <memory>
 #include <string>

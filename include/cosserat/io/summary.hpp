@@ -1,6 +1,7 @@
 #pragma once
-// The run summary: one JSON object whose keys are fixed by shared/DESIGN.md ("Interfaces"),
-// read by scripts that compare runs, so names and types here do not change.
+// The run summary: one JSON object whose keys are fixed by docs/design.md ("Interfaces") and listed
+// in docs/output.md ("Run summary"), read by scripts that compare runs, so names and types here do
+// not change.
 
 #include <mpi.h>
 
@@ -37,14 +38,15 @@ struct RunSummary {
   double max_speed = 0.0;
   std::string discretisation;  // "energy", "energy-nodal" or "flux"
   double kinetic_energy = 0.0;
-  double elastic_energy = 0.0;        // E of MODEL.md §2.5 (for the flux form too)
+  double elastic_energy = 0.0;        // E of docs/equations.md §2.5 (for the flux form too)
   double gravitational_energy = 0.0;  // −Σ m g·r
   Vec3 center_of_mass;
   std::string output;  // the HDF5 file written
   std::optional<LinearSolveStats> linear_solves;  // semi-implicit only
   std::optional<RestSummary> rest;                  // with --until-rest only
   std::optional<AdaptiveSummary> adaptive;          // with adaptive steps only (dt is null)
-  // With solids only (CONTACT.md §5): the run's contact maxima and each solid's final state.
+  // With solids only (docs/output.md, "Run summary"): the run's contact maxima and each solid's
+  // final state.
   std::optional<ContactSummary> contact;
   struct SolidReport {
     std::string name;

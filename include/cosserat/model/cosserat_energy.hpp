@@ -18,11 +18,11 @@ namespace cosserat {
 
 namespace energy {
 
-// The constants of the interior gradient (MODEL.md §2.5), with every grid factor folded in so
-// that a node multiplies as little as it can. With i = 11, 12, 22, H_i = h₁², h₁h₂, h₂², the
-// weight w_i = 1, 2, 1 of the (1, 2) terms in Σ_αβ, the forward edges D₁ = r(k+1, l) − r and
-// D₂ = r(k, l+1) − r, and β_i = n · Δ_i with Δ_i = H_i r_,αβ (the stencil's differences before
-// its division):
+// The constants of the interior gradient (docs/equations.md §2.5, "Nodal quadrature"), with every
+// grid factor folded in so that a node multiplies as little as it can. With i = 11, 12, 22,
+// H_i = h₁², h₁h₂, h₂², the weight w_i = 1, 2, 1 of the (1, 2) terms in Σ_αβ, the forward edges
+// D₁ = r(k+1, l) − r and D₂ = r(k, l+1) − r, and β_i = n · Δ_i with Δ_i = H_i r_,αβ (the
+// stencil's differences before its division):
 //   ε_i = e_i (D_α · D_β) − ½A_i,   κ_i = −β_i / H_i,
 //   ν_i = area (2Φ_i ε_i + Θ_i κ_i) / H_i      (∂E_p/∂(D_α · D_β), times 2 for i = 11, 22),
 //   μ_i = ∂E_p/∂β_i = −area w_i (2Ψ_i κ_i + Θ_i ε_i) / H_i.

@@ -1,5 +1,5 @@
 #pragma once
-// Internal force of the elastic Cosserat surface (MODEL.md §1–§2) on a local block.
+// Internal force of the elastic Cosserat surface (docs/equations.md §1–§2) on a local block.
 
 
 #include "cosserat/grid/block.hpp"
@@ -11,17 +11,18 @@
 namespace cosserat {
 
 
-// Rest data of a flat sheet: uniform, so kept as constants (MODEL.md §3).
+// Rest data of a flat sheet: uniform, so kept as constants (docs/equations.md §3).
 struct RestState {
   Sym2 metric{};          // A_ab
   Sym2 inverse_metric{};  // A^ab
-  Sym2 Phi{}, Psi{}, Theta{};  // MODEL.md §1, from the material and A^ab
+  Sym2 Phi{}, Psi{}, Theta{};  // docs/equations.md §1, from the material and A^ab
 };
 
 // Rest state of a flat sheet spanned by unit vectors u (x1) and v (x2).
 RestState flat_rest_state(const Material& material, const Vec3& u, const Vec3& v);
 
-// Everything the force phase needs from one node's geometry and resultants (MODEL.md §2.1).
+// Everything the force phase needs from one node's geometry and resultants
+// (docs/equations.md §2.1).
 struct NodeResultants {
   Vec3 a1, a2, normal;
   double N11, N12, N21, N22;  // N^{ab}: membrane resultants less the curvature coupling
@@ -36,7 +37,7 @@ class CosseratModel {
                 Borders borders);
 
   // Internal force per unit current area at every owned node, for the area factor f = 1:
-  // the physical force is (S0/S) times this (MODEL.md §1), so the internal acceleration is
+  // the physical force is (S0/S) times this (docs/equations.md §1), so the internal acceleration is
   // this times S0/M whatever the current area. Reads positions up to two nodes outside the
   // owned range (ghosts must be current). With `normals`, also the unit normal n of every
   // owned node at these positions, which the fluid term needs (§1).
@@ -59,8 +60,8 @@ class CosseratModel {
 };
 
 // This block's share of the total area S: the two triangles of every cell whose lower-left
-// node it owns (MODEL.md §3), each cell counted in multiples of `quantum` so that the global
-// total does not depend on the decomposition. Reads the ghosts at k + 1 and l + 1.
+// node it owns (docs/equations.md §3), each cell counted in multiples of `quantum` so that the
+// global total does not depend on the decomposition. Reads the ghosts at k + 1 and l + 1.
 QuantizedSum block_area(const Field<Vec3>& positions, double quantum);
 
 }  // namespace cosserat

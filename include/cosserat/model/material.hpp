@@ -1,5 +1,5 @@
 #pragma once
-// Material of MODEL.md §1: three symmetric 2x2 coefficient tensors and the mass.
+// Material of docs/equations.md §1: three symmetric 2x2 coefficient tensors and the mass.
 
 #include <array>
 #include <optional>

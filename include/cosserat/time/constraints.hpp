@@ -1,6 +1,6 @@
 #pragma once
 // Fixed nodes with axis masks, windows in steps and seconds and prescribed velocities
-// (MODEL.md §4.1, docs/scene-format.md "Fixes and loads"), for the nodes this block owns.
+// (docs/equations.md §4.1, docs/scene-format.md "Fixes and loads"), for the nodes this block owns.
 
 #include <cstdint>
 #include <vector>
@@ -17,7 +17,7 @@ class Constraints {
 
   // Switches the fixes acting during `step`, which starts at `time`, on and off. A component
   // that becomes held, or whose held velocity changes, is held from the value it has now
-  // (MODEL.md §4.1), not its rest value.
+  // (docs/equations.md §4.1), not its rest value.
   void begin_step(long step, double time, const Field<Vec3>& positions);
 
   // Held components to their held value at `time` (the time the field belongs to) / to their

@@ -1,7 +1,7 @@
 #pragma once
-// The edge test of the stability check (MODEL.md §4.2): which rows hold a node with an edge
-// that changed by more than the limit in one step, found either while a scheme's row walk still
-// has the rows in cache, or in a pass of its own.
+// The edge test of the stability check (docs/equations.md §4.2): which rows hold a node with an
+// edge that changed by more than the limit in one step, found either while a scheme's row walk
+// still has the rows in cache, or in a pass of its own.
 
 #include <vector>
 

@@ -1,6 +1,6 @@
 #pragma once
-// What the sheet looks like where the stability monitor (MODEL.md §4.2) stopped a run, so that
-// the message says what happened instead of only that a node moved too far.
+// What the sheet looks like where the stability monitor (docs/equations.md §4.2) stopped a run, so
+// that the message says what happened instead of only that a node moved too far.
 
 #include <string>
 

@@ -1,6 +1,6 @@
 #pragma once
-// The time integrators by name (MODEL.md §4). Header-only on purpose: the scene loader, one
-// module below `time`, checks the name a scene gives before any work (exit 2), and a header
+// The time integrators by name (docs/equations.md §4). Header-only on purpose: the scene loader,
+// one module below `time`, checks the name a scene gives before any work (exit 2), and a header
 // of names and an enum is vocabulary, not code to link.
 
 #include <algorithm>

@@ -1,5 +1,5 @@
 #pragma once
-// The time integrators of MODEL.md §4, one type per scheme family. Each owns the state it
+// The time integrators of docs/equations.md §4, one type per scheme family. Each owns the state it
 // carries from one step to the next under the name of what it holds; the Stepper around it
 // does what every scheme shares (constraint windows, per-step actions, the stability check,
 // the step count).
@@ -34,7 +34,7 @@ void for_owned(const Block& b, Body&& body) {
 }
 
 // What every scheme works with: the block and its halo, the forces, the constraints it applies
-// after every stage (MODEL.md §4.1), and the step.
+// after every stage (docs/equations.md §4.1), and the step.
 struct StepContext {
   const Block& block;
   Halo& halo;
@@ -80,8 +80,8 @@ class Scheme {
   void resume(double last_dt);
 
   // After accept(): the listed owned nodes move on with these velocities (a contact
-  // response's, CONTACT.md §3): a scheme that carries velocities takes them, the Verlet family
-  // rewrites r⁻ so that (r − r⁻)/Δt is the given velocity.
+  // response's, docs/contact.md, "Velocities"): a scheme that carries velocities takes them, the
+  // Verlet family rewrites r⁻ so that (r − r⁻)/Δt is the given velocity.
   virtual void set_velocities(const NodeVelocities& velocities) = 0;
 
   const Field<Vec3>& positions() const { return positions_; }
@@ -107,7 +107,7 @@ class Scheme {
   virtual std::optional<LinearSolveStats> linear_solves() const { return std::nullopt; }
 
  protected:
-  // Builds the history the first step needs (MODEL.md §4) from the state at step 0, whose
+  // Builds the history the first step needs (docs/equations.md §4) from the state at step 0, whose
   // positions are held and exchanged and whose velocities are held.
   virtual void start(Field<Vec3> velocities) = 0;
   // The family's own fields take their new values; accept() then swaps the positions.

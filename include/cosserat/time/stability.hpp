@@ -1,7 +1,7 @@
 #pragma once
 // The largest stable step of a scene and integrator, by bisection on the
-// stability monitor of MODEL.md §4.2 (SCENES.md: "never by eye"): the engine of
-// `cosserat stable-dt`.
+// stability monitor of docs/equations.md §4.2, never by eye (docs/scenes.md,
+// "S1–S6: the integrator study"): the engine of `cosserat stable-dt`.
 
 #include <mpi.h>
 

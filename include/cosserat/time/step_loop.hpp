@@ -1,8 +1,8 @@
 #pragma once
-// The step loop of a run (DESIGN.md principle 4: scene -> Simulation -> step loop -> writers):
-// it decides when a frame or a checkpoint is due and when the sheet has come to rest, and leaves
-// what is done then to an observer, so that the time module needs no files and tests can follow
-// the schedule without writing any.
+// The step loop of a run (docs/design.md, principle 4: scene -> Simulation -> step loop ->
+// writers): it decides when a frame or a checkpoint is due and when the sheet has come to rest, and
+// leaves what is done then to an observer, so that the time module needs no files and tests can
+// follow the schedule without writing any.
 
 #include <optional>
 #include <vector>

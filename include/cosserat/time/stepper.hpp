@@ -1,6 +1,6 @@
 #pragma once
-// The step of MODEL.md §4 for any scheme: the constraint windows of §4.1, the per-step actions,
-// the stability monitor of §4.2 and the step count around one Scheme.
+// The step of docs/equations.md §4 for any scheme: the constraint windows of §4.1, the per-step
+// actions, the stability monitor of §4.2 and the step count around one Scheme.
 
 #include <memory>
 #include <optional>
@@ -19,7 +19,7 @@
 
 namespace cosserat {
 
-// Where and when a run became unstable (MODEL.md §4.2), or the semi-implicit step's linear
+// Where and when a run became unstable (docs/equations.md §4.2), or the semi-implicit step's linear
 // solver failed (then k and l are -1).
 struct Instability {
   long step;    // the step whose new state failed the check
@@ -136,7 +136,7 @@ class Stepper {
   Constraints constraints_;
   double dt_;
   double h1_, h2_;
-  double max_move_;  // half the smaller grid spacing (MODEL.md §4.2)
+  double max_move_;  // half the smaller grid spacing (docs/equations.md §4.2)
   EdgeCheck edge_check_;
   RowWalk rows_;                 // this step's readers of the scheme's row walk
   std::vector<char> moved_rows_;  // ProposedStep::moved_rows
