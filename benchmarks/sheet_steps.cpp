@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
         "{\"nodes\": %ld, \"steps\": %ld, \"seconds\": %.6g, \"memory_bytes\": %.17g, "
         "\"rss_bytes\": %ld, \"max_rss_bytes\": %ld}\n",
         nodes, steps, seconds,
-        cosserat::Simulation::memory_bytes(sim.block(), scene.integrator, scene.discretisation),
+        cosserat::Simulation::memory_bytes(sim.block(), scene.integrator, scene.model_spec()),
         resident_bytes(), usage.ru_maxrss * 1024L);
   }
   MPI_Finalize();

@@ -1,5 +1,5 @@
-// The `cosserat` command line (DESIGN.md "Interfaces"): owns MPI, the options and the files; the
-// step loop (time/step_loop.hpp) says when a frame or a checkpoint is due.
+// The `cosserat` command line (docs/design.md, "Interfaces"): owns MPI, the options and the files;
+// the step loop (time/step_loop.hpp) says when a frame or a checkpoint is due.
 
 #include <mpi.h>
 #include <unistd.h>
@@ -27,7 +27,7 @@
 #include "cosserat/io/output_lock.hpp"
 #include "cosserat/io/stable_dt_table.hpp"
 #include "cosserat/io/summary.hpp"
-#include "cosserat/model/wave_speed.hpp"
+#include "cosserat/model/force_model.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/simulation.hpp"
 #include "cosserat/time/stability.hpp"
@@ -39,7 +39,7 @@
 
 namespace {
 
-// Exit statuses of DESIGN.md.
+// Exit statuses of docs/design.md, "Interfaces".
 constexpr int kExitOk = 0;
 constexpr int kExitFailure = 1;
 constexpr int kExitBadInput = 2;
@@ -179,7 +179,7 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
         return !cosserat::node_field(field).vector;
       }));
   const double mine = cosserat::Simulation::memory_bytes(
-      block, scene.integrator, scene.discretisation, scalar_fields, scene.solids);
+      block, scene.integrator, scene.model_spec(), scalar_fields, scene.solids);
   double needed = 0.0;
   MPI_Allreduce(&mine, &needed, 1, MPI_DOUBLE, MPI_SUM, node);
   int node_rank = 0;
@@ -237,8 +237,8 @@ std::optional<int> bad_input(const std::string& scene_path, int rank, Work&& wor
   return std::nullopt;
 }
 
-// The files a run will write, checked before any work (DESIGN.md principle 6): none may be the
-// scene, the checkpoint it restarts from (but its own checkpoint, which a restart continues) or
+// The files a run will write, checked before any work (docs/design.md, principle 6): none may be
+// the scene, the checkpoint it restarts from (but its own checkpoint, which a restart continues) or
 // another of them; each must be a plain file in a folder that takes one; none may hold an
 // earlier run's results unless the run is told to overwrite them or restarts. Returns what is
 // wrong, or nothing.
@@ -422,7 +422,7 @@ int run(const RunOptions& options, int rank, int ranks) {
                  output);
     if (rank == 0 && !failure->solver_failure) {
       const CflEstimate cfl =
-          cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
+          cosserat::rest_step_estimate(scene.model_spec());
       if (scene.adaptive)
         fmt::print(stderr,
                    "hint: adaptive steps went down to time.dt.min = {:.3g} s (the rest sheet's "
@@ -507,7 +507,7 @@ int stable_dt(const StableDtOptions& options, int rank) {
   set_threads(*decomposition, options.threads, rank);
 
   const Scene& first = scenes.front();
-  const CflEstimate cfl = cfl_estimate(first.material, first.areal_density(), first.h1(), first.h2());
+  const CflEstimate cfl = rest_step_estimate(first.model_spec());
   const std::string title = first.title.empty() ? first.name : first.title;
   if (rank == 0) {
     fmt::print("{}: {} x {} nodes, stable over T = {} s, to {:.3g} %; CFL estimate {:.4g} s "

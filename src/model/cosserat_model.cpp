@@ -2,9 +2,10 @@
 
 #include <algorithm>
 
+#include "cosserat/model/surface_measures.hpp"
 #include "surface_geometry.hpp"
 
-// Reach of the stencil (MODEL.md §2.4), which sizes the ghost layer (kGhostWidth = 2):
+// Reach of the stencil (docs/equations.md §2.4), which sizes the ghost layer (kGhostWidth = 2):
 //  - resultants at p read positions in the 3x3 box around p;
 //  - traction T^1 at p reads resultants at p, p+e1 (∂_1 M^11) and p-e2 (∂_2 M^12);
 //    T^2 at p reads resultants at p, p+e2 and p-e1;
@@ -18,7 +19,7 @@ namespace cosserat {
 
 namespace {
 
-// Φ, Ψ, Θ^{ab} = c_ab (A^aa A^bb + 2 (A^ab)^2), no summation (MODEL.md §1).
+// Φ, Ψ, Θ^{ab} = c_ab (A^aa A^bb + 2 (A^ab)^2), no summation (docs/equations.md §1).
 Sym2 contravariant(const Sym2& c, const Sym2& Ainv) {
   const double A11 = Ainv[0], A12 = Ainv[1], A22 = Ainv[2];
   return {c[0] * (A11 * A11 + 2.0 * A11 * A11), c[1] * (A11 * A22 + 2.0 * A12 * A12),
@@ -29,7 +30,7 @@ Sym2 contravariant(const Sym2& c, const Sym2& Ainv) {
 
 RestState flat_rest_state(const Material& material, const Vec3& u, const Vec3& v) {
   RestState rest;
-  rest.metric = {dot(u, u), dot(u, v), dot(v, v)};
+  rest.metric = flat_metric(u, v);
   const double det = rest.metric[0] * rest.metric[2] - rest.metric[1] * rest.metric[1];
   rest.inverse_metric = {rest.metric[2] / det, -rest.metric[1] / det, rest.metric[0] / det};
   rest.Phi = contravariant(material.zeta, rest.inverse_metric);
@@ -90,7 +91,7 @@ inline double shear_christoffel2(const geometry::Christoffel& G, const Sym2& M) 
 
 }  // namespace
 
-// Geometry and stress resultants of node (k, l): MODEL.md §2.1 (with the §2.3 border rules
+// Geometry and stress resultants of node (k, l): docs/equations.md §2.1 (with the §2.3 border rules
 // when they are on) and the constitutive law of §1 with f = 1.
 void CosseratModel::compute_resultants(const Field<Vec3>& R, int k, int l) {
   using namespace geometry;
@@ -131,8 +132,8 @@ void CosseratModel::compute_resultants(const Field<Vec3>& R, int k, int l) {
 
 // D⁻ of the twisting moment M^{12} on the near border (B1 or B2), where the cell before p is
 // missing. The symmetric rules extend §2.3 rule 1 there: the missing cell carries no twisting
-// moment, so D⁻ M = (M[p] − 0)/h. MODEL.md §2.2's D⁺ instead (kept for "published") makes the
-// rest-state Jacobian non-symmetric along B1 and B2 (3e-3 relative on a 12 x 12 sheet, against
+// moment, so D⁻ M = (M[p] − 0)/h. docs/equations.md §2.2's D⁺ instead (kept for "published") makes
+// the rest-state Jacobian non-symmetric along B1 and B2 (3e-3 relative on a 12 x 12 sheet, against
 // 2e-6 with this rule; docs/model.md).
 double CosseratModel::near_border_difference(double M_here, double M_next, double h) const {
   return symmetric_borders_ ? M_here / h : (M_next - M_here) / h;
@@ -141,7 +142,7 @@ double CosseratModel::near_border_difference(double M_here, double M_next, doubl
 // The Γ·M part of the transverse shear on the face between p and p + e_a. Both derivative
 // terms of N^{3a} are centred on that face (D⁺_a M^{aa} between the nodes, D⁻_b M^{ab} between
 // two cells), so the symmetric rules put Γ·M there too, as the mean of the two nodes. Taken at
-// p alone (MODEL.md §2.2, kept for "published") it lets a sheet folded sharply over a held
+// p alone (docs/equations.md §2.2, kept for "published") it lets a sheet folded sharply over a held
 // line blow up whatever the step (docs/model.md, "Known limits": 9 of 23 such runs, against
 // 1 of 23 with the face value).
 double CosseratModel::on_face(double at_node, double at_next_node) const {

@@ -1,4 +1,4 @@
-// Scene loader: TOML text -> validated Scene (shared/spec/SCENE_FORMAT.md). This file holds the
+// Scene loader: TOML text -> validated Scene (docs/scene-format.md). This file holds the
 // sections: what each accepts, its defaults, and the order they depend on one another.
 //
 // Every rejection is one line that starts with the file (and the line the value came from, or
@@ -24,7 +24,7 @@
 #include <string_view>
 
 #include "checked_toml.hpp"
-#include "cosserat/model/wave_speed.hpp"
+#include "cosserat/model/force_model.hpp"
 #include "overrides.hpp"
 #include "solids.hpp"
 
@@ -283,7 +283,7 @@ Gusts read_gusts(const Table& gust) {
 }
 
 // [environment.wind], or the same table under its older name [environment.fluid]; `drag` is
-// likewise the newer name of `viscosity`. Users say wind; MODEL.md §1 says fluid.
+// likewise the newer name of `viscosity`. Users say wind; docs/equations.md §1 says fluid.
 Fluid read_wind(const Table& wind) {
   wind.allow({"drag", "velocity", "gust", "viscosity"});
   const auto drag = wind.find("drag");
@@ -412,7 +412,7 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
   }
   // The rest sheet's CFL step sets the scale of the smallest step worth taking.
   const CflEstimate cfl =
-      cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
+      rest_step_estimate(scene.model_spec());
   adaptive.min = 1e-6 * std::min(adaptive.max, adaptive.safety * cfl.dt);
   if (dt)
     if (const auto min = dt->find("min")) {
@@ -621,7 +621,7 @@ NodeSet read_node_set(const Table& block, const Scene& scene) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Constraints (MODEL.md §4.1)
+// Constraints (docs/equations.md §4.1)
 
 // Inclusive windows in steps and in seconds; the ends default to the end of the run.
 Window read_window(const Table& block, const Scene& scene) {
@@ -709,8 +709,8 @@ Load read_load(const Table& block, const Scene& scene) {
   return load;
 }
 
-// MODEL.md §1: the energy is positive definite iff Theta^2 < 4 Phi Psi for every component.
-// Phi, Psi and Theta are zeta, xi and phi times the same rest-metric factor
+// docs/equations.md §1: the energy is positive definite iff Theta^2 < 4 Phi Psi for every
+// component. Phi, Psi and Theta are zeta, xi and phi times the same rest-metric factor
 // A^aa A^bb + 2 (A^ab)^2 > 0, so the factor cancels and the test is phi^2 < 4 zeta xi.
 void warn_if_not_positive_definite(const Origin& origin, Scene& scene) {
   constexpr std::array<std::string_view, 3> components{"11", "12", "22"};

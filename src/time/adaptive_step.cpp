@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cosserat/model/wave_speed.hpp"
+#include "cosserat/model/force_model.hpp"
 
 namespace cosserat {
 
@@ -18,15 +18,8 @@ constexpr double kMargin = 0.9;
 constexpr double kRegrow = 1.1;
 }  // namespace
 
-// A membrane strain ε = (λ² − 1)/2 along an edge stretched by λ stiffens the edge: the second
-// derivative of Φ ε² with respect to λ is Φ (3λ² − 1) (MODEL.md §2.5 with ε_αα as in §2.1), so
-// the membrane wave speed grows by √((3λ² − 1)/2) over the rest sheet's. Bending's rate is
-// that of the rest sheet (it does not stiffen with stretch to first order).
 double stability_estimate(const Scene& scene, const StateMeasures& state) {
-  const CflEstimate cfl =
-      cfl_estimate(scene.material, scene.areal_density(), scene.h1(), scene.h2());
-  const double stiffening = std::max(1.0, 0.5 * (3.0 * state.stretch2 - 1.0));
-  double estimate = std::min(cfl.membrane_dt / std::sqrt(stiffening), cfl.bending_dt);
+  double estimate = stretched_step_estimate(scene.model_spec(), state.stretch2);
   if (state.max_speed > 0.0)
     estimate = std::min(estimate, 0.25 * std::min(scene.h1(), scene.h2()) / state.max_speed);
   return estimate;

@@ -5,26 +5,18 @@
 #include <cmath>
 
 #include "cosserat/grid/reduce.hpp"
+#include "cosserat/model/cosserat_model.hpp"
 
 namespace cosserat {
 
 Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions)
     : block_(&block),
-      discretisation_(scene.discretisation),
-      energy_(block, scene.h1(), scene.h2(), flat_rest_state(scene.material, scene.u, scene.v),
-              scene.discretisation == Discretisation::energy_nodal ? Quadrature::nodal
-                                                                   : Quadrature::trapezoidal),
       h1h2_(scene.h1() * scene.h2()),
       // 2⁻⁴⁰ of a grid cell: far below the round-off of a double sum over the cells.
       area_quantum_(std::ldexp(h1h2_, -40)),
       mass_(scene.material.mass),
       rest_area_(total_area(rest_positions)),
-      // μ0 h1 h2 = (M/S0) h1 h2 at a node inside, times its share of the dual area in the
-      // trapezoidal quadrature: the lumped constant masses of the energy forms.
-      node_mass_(is_energy_form(scene.discretisation)
-                     ? energy_.node_mass(scene.material.mass / rest_area_ * h1h2_)
-                     : NodeMass{scene.material.mass / (static_cast<double>(scene.m) * scene.n),
-                                scene.m, scene.n, false}),
+      model_(make_force_model(scene.model_spec(), block, rest_area_)),
       gravity_(scene.gravity),
       damping_(scene.damping),
       fluid_(scene.fluid) {
@@ -34,21 +26,19 @@ Dynamics::Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& re
     for (const NodeIndex& node : load.nodes.nodes)
       if (block.owns(node.k, node.l)) {
         // A pressure acts on the node's dual area: h1 h2 times its share of it.
-        const double area = load.per_area ? h1h2_ * node_mass_.weight(node.k, node.l) : 1.0;
+        const double area =
+            load.per_area ? h1h2_ * model_->node_mass().weight(node.k, node.l) : 1.0;
         loads_.push_back(PointLoad{node.k, node.l, area * load.force, load.window});
       }
   // In row order, for free_acceleration_rows to find a row's loads; stable, so that a node's
   // own loads keep the scene's order and their sum its bits.
   std::stable_sort(loads_.begin(), loads_.end(),
                    [](const PointLoad& a, const PointLoad& b) { return a.l < b.l; });
-  if (discretisation_ == Discretisation::flux)
-    flux_.emplace(block, scene.h1(), scene.h2(),
-                  flat_rest_state(scene.material, scene.u, scene.v), scene.borders);
-  // μ = M/S enters only through loads, fluid and damping (MODEL.md §3): without them the
+  // μ = M/S enters only through loads, fluid and damping (docs/equations.md §3): without them the
   // current area is never needed during a step. The energy form's mass is constant (§2.5), so
   // it never is. The area is a collective reduction: decide from the scene, which every rank
   // shares.
-  needs_area_ = discretisation_ == Discretisation::flux &&
+  needs_area_ = model_->density_follows_area() &&
                 (!scene.loads.empty() || fluid_.has_value() || damping_ > 0.0);
 }
 
@@ -62,22 +52,11 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
   assert((normals != nullptr) == has_fluid());
   const Vec3 g = gravity_;
   const bool fluid = fluid_.has_value();
-  double inverse_density = 0.0;
-  if (flux_) {
-    flux_->internal_force(r, a, normals);
-    // S/M = 1/μ; the internal force carries f = S0/S, so its acceleration is f̂ S0/M (§3).
-    if (needs_area_) inverse_density = total_area(r) / mass_;
-    const double internal_scale = rest_area_ / mass_;
-#pragma omp parallel for schedule(static)
-    for (int l = b.l0; l < b.l1; ++l)
-#pragma omp simd
-      for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l) + g;
-  } else {
-    // Newtons on the constant lumped masses (docs/model.md, "Energy quadrature"), with gravity,
-    // written by the kernel; damping and fluid per unit area act on μ0.
-    energy_.acceleration(r, a, normals, 1.0 / node_mass_.interior, g);
-    inverse_density = rest_inverse_density();
-  }
+  model_->free_acceleration(r, g, a, normals);
+  // Damping, fluid and loads act on μ: M/S where the model's density follows the area (S/M
+  // only when a term needs it, docs/equations.md §3), μ0 = M/S0 where it does not.
+  double inverse_density = rest_inverse_density();
+  if (model_->density_follows_area()) inverse_density = needs_area_ ? total_area(r) / mass_ : 0.0;
   const double fluid_coefficient = fluid ? fluid_->viscosity * inverse_density : 0.0;
   const Vec3 fluid_velocity = fluid ? fluid_->velocity : Vec3{};
   if (gusts_) {
@@ -104,24 +83,24 @@ VelocityTerms Dynamics::free_acceleration(const Field<Vec3>& r, long step, Field
   for (const PointLoad& load : loads_)
     if (load.window.contains(step, time_))
       a(load.k, load.l) +=
-          (inverse_density / (h1h2_ * node_mass_.weight(load.k, load.l))) * load.force;
+          (inverse_density / (h1h2_ * model_->node_mass().weight(load.k, load.l))) * load.force;
   return VelocityTerms{damping_ * inverse_density, fluid_coefficient};
 }
 
 void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
-                                      const CosseratEnergy::RowConsumer& consume) {
+                                      const ForceModel::RowConsumer& consume) {
   assert(fuses_rows());
   const Block& b = *block_;
   const double load_scale = rest_inverse_density() / h1h2_;
-  energy_.internal_force_rows(r, 1.0 / node_mass_.interior, gravity_,
-                              [&](int l, double* x, double* y, double* z) {
+  const NodeMass& node_mass = model_->node_mass();
+  model_->free_acceleration_rows(r, gravity_, [&](int l, double* x, double* y, double* z) {
     auto load = std::lower_bound(loads_.begin(), loads_.end(), l,
                                  [](const PointLoad& a, int row) { return a.l < row; });
     for (; load != loads_.end() && load->l == l; ++load)
       if (load->window.contains(step, time_)) {
         const auto i = static_cast<std::size_t>(load->k - b.k0);
         const Vec3 acceleration =
-            (load_scale / node_mass_.weight(load->k, load->l)) * load->force;
+            (load_scale / node_mass.weight(load->k, load->l)) * load->force;
         x[i] += acceleration.x;
         y[i] += acceleration.y;
         z[i] += acceleration.z;
@@ -131,20 +110,11 @@ void Dynamics::free_acceleration_rows(const Field<Vec3>& r, long step,
 }
 
 double Dynamics::elastic_energy(const Field<Vec3>& r) {
-  return global_sum(energy_.block_energy(r), block_->comm);
+  return global_sum(model_->block_energy(r), block_->comm);
 }
 
 void Dynamics::internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a) {
-  if (!flux_) {
-    energy_.acceleration(r, a, nullptr, 1.0 / node_mass_.interior, Vec3{});
-    return;
-  }
-  const Block& b = *block_;
-  flux_->internal_force(r, a);
-  const double internal_scale = rest_area_ / mass_;
-#pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) a(k, l) = internal_scale * a(k, l);
+  model_->internal_acceleration(r, a);
 }
 
 void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long step,

@@ -34,7 +34,7 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
   return v;
 }
 
-// CONTACT.md: the scene's solids against every proposed step, whatever the scheme; the run's
+// docs/contact.md: the scene's solids against every proposed step, whatever the scheme; the run's
 // maxima kept over accepted steps.
 class Simulation::ContactAction final : public StepAction, public RowReader {
  public:
@@ -105,8 +105,8 @@ ContactSummary Simulation::contact_summary() const {
   return contact_action_ ? contact_action_->summary() : ContactSummary{};
 }
 
-double Simulation::memory_bytes(const Block& block, Integrator integrator,
-                                Discretisation discretisation, std::size_t scalar_output_fields,
+double Simulation::memory_bytes(const Block& block, Integrator integrator, const ModelSpec& model,
+                                std::size_t scalar_output_fields,
                                 const std::vector<SolidSpec>& solids) {
   const double ghosted_nodes = static_cast<double>(block.local_size());
   const double owned_nodes = static_cast<double>(block.owned_k()) * block.owned_l();
@@ -114,9 +114,7 @@ double Simulation::memory_bytes(const Block& block, Integrator integrator,
   // stages, two weighted sums), and a fluid one more for the normals.
   // The force kernel's intermediates: the flux form's resultants and tractions per node; the
   // energy form keeps only row buffers, 36 rows of doubles a thread (docs/kernel.md).
-  const double kernel = discretisation == Discretisation::flux
-                            ? static_cast<double>(sizeof(NodeResultants) + 2 * sizeof(Vec3))
-                            : 0.0;
+  const double kernel = kernel_bytes_per_node(model);
   const double row_buffers = 36.0 * sizeof(double) * (block.stride() + 16) * omp_get_max_threads();
   const double per_node =
       kernel + 10 * sizeof(Vec3) + static_cast<double>(scalar_output_fields * sizeof(double));
@@ -133,8 +131,7 @@ void Simulation::node_field(OutputField field, Field<double>& values) const {
   const Field<Vec3>& r = stepper_.positions();
   switch (field) {
     case OutputField::area_ratio:
-      area_ratio(r, scene.h1(), scene.h2(),
-                 flat_rest_state(scene.material, scene.u, scene.v).metric, values);
+      area_ratio(r, scene.h1(), scene.h2(), flat_metric(scene.u, scene.v), values);
       return;
     case OutputField::curvature:
       mean_curvature(r, scene.h1(), scene.h2(), values);

@@ -1,7 +1,7 @@
 #pragma once
 // Per-node measures of the deformed sheet that a run writes beside its positions (docs/output.md,
-// "Fields"), from the per-node geometry of MODEL.md §2.1 at the owned nodes of a block. A node's
-// value depends on its 3 × 3 box alone (the ghosts one node beyond the owned range must be
+// "Fields"), from the per-node geometry of docs/equations.md §2.1 at the owned nodes of a block. A
+// node's value depends on its 3 × 3 box alone (the ghosts one node beyond the owned range must be
 // current), so every decomposition and thread count gives the same bits.
 
 #include "cosserat/grid/block.hpp"
@@ -10,8 +10,11 @@
 
 namespace cosserat {
 
-// √(a/A), a = det a_αβ and A = det A_αβ of the rest metric (MODEL.md §1), with the tangents of
-// §2.1 rule 1: the area of the surface element at the node over its rest area.
+// The metric A_αβ of the flat rest sheet spanned by the grid directions u and v.
+inline Sym2 flat_metric(const Vec3& u, const Vec3& v) { return {dot(u, u), dot(u, v), dot(v, v)}; }
+
+// √(a/A), a = det a_αβ and A = det A_αβ of the rest metric (docs/equations.md §1), with the
+// tangents of §2.1 rule 1: the area of the surface element at the node over its rest area.
 void area_ratio(const Field<Vec3>& positions, double h1, double h2, const Sym2& rest_metric,
                 Field<double>& ratio);
 

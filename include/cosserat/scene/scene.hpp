@@ -1,6 +1,6 @@
 #pragma once
 // A validated scene: the only thing the rest of the solver reads from a scene file
-// (shared/spec/SCENE_FORMAT.md). Data flows one way: file -> Scene -> Simulation.
+// (docs/scene-format.md). Data flows one way: file -> Scene -> Simulation.
 
 #include <array>
 #include <cstdint>
@@ -12,6 +12,7 @@
 
 #include "cosserat/contact/solid.hpp"
 #include "cosserat/model/borders.hpp"
+#include "cosserat/model/force_model.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/time/integrator.hpp"
@@ -85,8 +86,8 @@ struct Gusts {
   std::uint64_t seed = 0;
 };
 
-// The fluid term of MODEL.md §1, which scenes call wind: [environment.wind], or its older name
-// [environment.fluid].
+// The fluid term of docs/equations.md §1, which scenes call wind: [environment.wind], or its older
+// name [environment.fluid].
 struct Fluid {
   double viscosity = 0.0;  // rho_R, N s/m^3 (the scene's `drag`)
   Vec3 velocity;           // u: the mean wind, m/s
@@ -169,12 +170,16 @@ struct Scene {
   // Warnings the loader found (e.g. a coupling that breaks positive definiteness).
   std::vector<std::string> warnings;
   // φ² ≥ 4ζξ in some component: the stored energy has directions that cost nothing or less
-  // (MODEL.md §1), so grid-scale creases may grow whatever the step.
+  // (docs/equations.md §1), so grid-scale creases may grow whatever the step.
   bool energy_indefinite = false;
 
   double h1() const { return size1 / (m - 1); }
   double h2() const { return size2 / (n - 1); }
   double areal_density() const { return material.mass / (size1 * size2); }  // μ0, kg/m²
+  // What the force model is built from (make_force_model, rest_step_estimate).
+  ModelSpec model_spec() const {
+    return ModelSpec{discretisation, borders, material, h1(), h2(), u, v, areal_density()};
+  }
 };
 
 // Reads and validates a scene file. `overrides` are "dotted.key=toml-value" strings applied

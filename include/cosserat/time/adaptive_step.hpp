@@ -15,10 +15,9 @@ struct StateMeasures {
   double max_speed = 0.0;  // m/s
 };
 
-// The step the state allows, before the safety factor: the CFL step of the rest sheet
-// (model/wave_speed.hpp) with its membrane part shortened by the stiffening of stretched
-// edges, and no more than a quarter of the smaller spacing per step at the fastest node (half
-// of what the monitor allows).
+// The step the state allows, before the safety factor: the force model's for its stretched
+// edges (stretched_step_estimate, model/force_model.hpp), and no more than a quarter of the
+// smaller spacing per step at the fastest node (half of what the monitor allows).
 double stability_estimate(const Scene& scene, const StateMeasures& state);
 
 class AdaptiveSteps {

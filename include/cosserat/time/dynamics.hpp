@@ -1,20 +1,20 @@
 #pragma once
-// The right-hand side of the equation of motion (MODEL.md §1, §4): internal force plus exactly
-// the external terms the scene declares (DESIGN.md principle 3).
+// The right-hand side of the equation of motion (docs/equations.md §1, §4): internal force plus
+// exactly the external terms the scene declares (docs/design.md, principle 3).
 
+#include <memory>
 #include <optional>
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
-#include "cosserat/model/cosserat_energy.hpp"
-#include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/model/force_model.hpp"
 #include "cosserat/scene/scene.hpp"
 #include "cosserat/time/gust_field.hpp"
 
 namespace cosserat {
 
 // Coefficients of the terms linear in velocity, per unit mass: the acceleration is
-// a_free − damping v − fluid (n·v) n (MODEL.md §4).
+// a_free − damping v − fluid (n·v) n (docs/equations.md §4).
 struct VelocityTerms {
   double damping = 0.0;  // ϱ_D / μ
   double fluid = 0.0;    // ϱ_R / μ
@@ -32,21 +32,19 @@ class Dynamics {
 
   // Whether free_acceleration_rows can stand for free_acceleration: the energy form without a
   // fluid, whose terms need every row's normals before any row's acceleration is complete.
-  bool fuses_rows() const {
-    return is_energy_form(discretisation_) && !fluid_.has_value();
-  }
+  bool fuses_rows() const { return model_->fuses_rows() && !fluid_.has_value(); }
   // The velocity terms free_acceleration would return; with fuses_rows() only.
   VelocityTerms row_velocity_terms() const {
     return VelocityTerms{damping_ * rest_inverse_density(), 0.0};
   }
   // free_acceleration's `a`, without the field: each finished row goes to `consume` (see
-  // CosseratEnergy::internal_force_rows) while it is in cache, so that a scheme's update reads
+  // ForceModel::free_acceleration_rows) while it is in cache, so that a scheme's update reads
   // it there. The same bits as free_acceleration's; with fuses_rows() only.
   void free_acceleration_rows(const Field<Vec3>& r, long step,
-                              const CosseratEnergy::RowConsumer& consume);
+                              const ForceModel::RowConsumer& consume);
 
   // The internal force's share of the acceleration, f_int/μ, into `a`: independent of S
-  // (MODEL.md §3), so a function of the positions alone. The semi-implicit baseline
+  // (docs/equations.md §3), so a function of the positions alone. The semi-implicit baseline
   // differentiates it.
   void internal_acceleration(const Field<Vec3>& r, Field<Vec3>& a);
 
@@ -66,19 +64,19 @@ class Dynamics {
   void set_stage_time(double time) { stage_time_ = time; }
 
   bool has_fluid() const { return fluid_.has_value(); }
-  // The stored energy E of MODEL.md §2.5 (J), a global sum; reads the ghosts of r. For the
+  // The stored energy E of docs/equations.md §2.5 (J), a global sum; reads the ghosts of r. For the
   // flux form too, whose force is not its gradient: there it shows what the discretisation
   // does to the energy.
   double elastic_energy(const Field<Vec3>& r);
   // Its density per unit rest area at every owned node (J/m²), for either form alike; reads the
   // ghosts of r one node beyond the owned range.
   void energy_density(const Field<Vec3>& r, Field<double>& density) const {
-    energy_.energy_density(r, density);
+    model_->energy_density(r, density);
   }
   // The masses the nodes carry (kg): μ0 h1 h2 times the node's share of the dual area in the
   // energy forms (docs/model.md, "Energy quadrature"; the share is 1 at every node of the nodal
   // quadrature), M/(m n) at every node in the flux form's diagnostics.
-  const NodeMass& node_mass() const { return node_mass_; }
+  const NodeMass& node_mass() const { return model_->node_mass(); }
 
   bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
   double rest_area() const { return rest_area_; }
@@ -92,18 +90,15 @@ class Dynamics {
     Window window;
   };
 
-  // 1/μ0 = S0/M, the energy form's constant inverse areal density (MODEL.md §2.5).
+  // 1/μ0 = S0/M, the energy form's constant inverse areal density (docs/equations.md §2.5).
   double rest_inverse_density() const { return rest_area_ / mass_; }
 
   const Block* block_;
-  Discretisation discretisation_;
-  std::optional<CosseratModel> flux_;
-  CosseratEnergy energy_;  // the force of the energy form; the energy of either
   double h1h2_;
   double area_quantum_;
   double mass_;
   double rest_area_;
-  NodeMass node_mass_;
+  std::unique_ptr<ForceModel> model_;
   Vec3 gravity_;
   double damping_;
   std::optional<Fluid> fluid_;

@@ -1,6 +1,6 @@
 #pragma once
 // A scene set up on this rank's block: rest state, dynamics, constraints and integrator
-// (DESIGN.md principle 4: scene -> Simulation -> step loop -> writers).
+// (docs/design.md, principle 4: scene -> Simulation -> step loop -> writers).
 
 #include <mpi.h>
 
@@ -19,7 +19,8 @@
 namespace cosserat {
 
 // Whole-sheet quantities reported in the run summary; all global reductions.
-// What contact did over the accepted steps so far (CONTACT.md §5), the same on every rank.
+// What contact did over the accepted steps so far (docs/output.md, "Run summary"), the same on
+// every rank.
 struct ContactSummary {
   double max_penetration = 0.0;  // m, deepest any node sat inside a solid after a step
   long max_contacts = 0;         // most nodes moved by contact in one step
@@ -49,8 +50,8 @@ class Simulation {
   // explicit scheme, the force kernel's intermediates, the output buffer and the
   // `scalar_output_fields` fields of node_field() the output keeps, the contact with `solids`,
   // and for the semi-implicit one its PETSc matrix and colouring.
-  static double memory_bytes(const Block& block, Integrator integrator,
-                             Discretisation discretisation, std::size_t scalar_output_fields = 0,
+  static double memory_bytes(const Block& block, Integrator integrator, const ModelSpec& model,
+                             std::size_t scalar_output_fields = 0,
                              const std::vector<SolidSpec>& solids = {});
 
   std::optional<Instability> step() { return stepper_.step(); }
@@ -74,8 +75,8 @@ class Simulation {
   const Contact* contact() const { return contact_.get(); }
   ContactSummary contact_summary() const;
 
-  // The stored energy of MODEL.md §2.5 at the current positions (J); a global sum that costs
-  // about one force evaluation, so not part of diagnostics().
+  // The stored energy of docs/equations.md §2.5 at the current positions (J); a global sum that
+  // costs about one force evaluation, so not part of diagnostics().
   double elastic_energy() { return dynamics_.elastic_energy(stepper_.positions()); }
 
   // A scalar field of the output at the current state into the owned nodes of `values`
