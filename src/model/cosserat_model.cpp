@@ -222,23 +222,5 @@ void CosseratModel::internal_force(const Field<Vec3>& r, Field<Vec3>& force,
   }
 }
 
-QuantizedSum block_area(const Field<Vec3>& r, double quantum) {
-  const Block& b = r.block();
-  const int kend = std::min(b.k1, b.m - 1), lend = std::min(b.l1, b.n - 1);
-  std::vector<QuantizedSum> row_area(static_cast<std::size_t>(std::max(lend - b.l0, 0)),
-                                     QuantizedSum(quantum));
-#pragma omp parallel for schedule(static)
-  for (int l = b.l0; l < lend; ++l) {
-    QuantizedSum sum(quantum);
-    for (int k = b.k0; k < kend; ++k) {
-      const Vec3 p = r(k, l), q = r(k + 1, l), s = r(k + 1, l + 1), t = r(k, l + 1);
-      sum.add(0.5 * (norm(cross(q - p, s - p)) + norm(cross(s - p, t - p))));
-    }
-    row_area[static_cast<std::size_t>(l - b.l0)] = sum;
-  }
-  QuantizedSum area(quantum);
-  for (const QuantizedSum& a : row_area) area.add(a);
-  return area;
-}
 
 }  // namespace cosserat

@@ -1,6 +1,8 @@
 #include "cosserat/model/surface_measures.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "surface_geometry.hpp"
 
@@ -35,6 +37,25 @@ void mean_curvature(const Field<Vec3>& r, double h1, double h2, Field<double>& c
       curvature(k, l) =
           0.5 * (upper[0] * bend[0] + 2.0 * upper[1] * bend[1] + upper[2] * bend[2]);
     }
+}
+
+QuantizedSum block_area(const Field<Vec3>& r, double quantum) {
+  const Block& b = r.block();
+  const int kend = std::min(b.k1, b.m - 1), lend = std::min(b.l1, b.n - 1);
+  std::vector<QuantizedSum> row_area(static_cast<std::size_t>(std::max(lend - b.l0, 0)),
+                                     QuantizedSum(quantum));
+#pragma omp parallel for schedule(static)
+  for (int l = b.l0; l < lend; ++l) {
+    QuantizedSum sum(quantum);
+    for (int k = b.k0; k < kend; ++k) {
+      const Vec3 p = r(k, l), q = r(k + 1, l), s = r(k + 1, l + 1), t = r(k, l + 1);
+      sum.add(0.5 * (norm(cross(q - p, s - p)) + norm(cross(s - p, t - p))));
+    }
+    row_area[static_cast<std::size_t>(l - b.l0)] = sum;
+  }
+  QuantizedSum area(quantum);
+  for (const QuantizedSum& a : row_area) area.add(a);
+  return area;
 }
 
 }  // namespace cosserat

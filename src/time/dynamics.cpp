@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "cosserat/grid/reduce.hpp"
-#include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/model/surface_measures.hpp"
 
 namespace cosserat {
 

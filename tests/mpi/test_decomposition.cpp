@@ -18,6 +18,7 @@
 #include "cosserat/grid/halo.hpp"
 #include "cosserat/model/cosserat_energy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/model/surface_measures.hpp"
 #include "cosserat/time/step_loop.hpp"
 #include "mpi_support.hpp"
 #include "support/sheets.hpp"

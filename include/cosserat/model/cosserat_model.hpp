@@ -3,7 +3,6 @@
 
 
 #include "cosserat/grid/block.hpp"
-#include "cosserat/grid/reduce.hpp"
 #include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/grid/vec3.hpp"
@@ -58,10 +57,5 @@ class CosseratModel {
   Field<NodeResultants> resultants_;
   Field<Vec3> traction1_, traction2_;
 };
-
-// This block's share of the total area S: the two triangles of every cell whose lower-left
-// node it owns (docs/equations.md §3), each cell counted in multiples of `quantum` so that the
-// global total does not depend on the decomposition. Reads the ghosts at k + 1 and l + 1.
-QuantizedSum block_area(const Field<Vec3>& positions, double quantum);
 
 }  // namespace cosserat

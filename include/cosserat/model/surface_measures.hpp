@@ -5,6 +5,7 @@
 // current), so every decomposition and thread count gives the same bits.
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/grid/reduce.hpp"
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/model/material.hpp"
 
@@ -21,5 +22,10 @@ void area_ratio(const Field<Vec3>& positions, double h1, double h2, const Sym2& 
 // The mean curvature H = ½ a^{αβ} b_αβ (1/m), b_αβ = n · r_,αβ with n and r_,αβ of §2.1 rules
 // 2 and 3: positive where the sheet bends towards n (the side a₁ × a₂ points to).
 void mean_curvature(const Field<Vec3>& positions, double h1, double h2, Field<double>& curvature);
+
+// This block's share of the total area S: the two triangles of every cell whose lower-left
+// node it owns (docs/equations.md §3), each cell counted in multiples of `quantum` so that the
+// global total does not depend on the decomposition. Reads the ghosts at k + 1 and l + 1.
+QuantizedSum block_area(const Field<Vec3>& positions, double quantum);
 
 }  // namespace cosserat
