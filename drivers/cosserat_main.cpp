@@ -386,10 +386,12 @@ int run(const RunOptions& options, int rank, int ranks) {
   const bool on_terminal = !options.quiet && rank == 0 && isatty(STDERR_FILENO);
   if (!options.quiet && rank == 0) {
     const std::string steps =
-        scene.adaptive
-            ? fmt::format("{} s in adaptive steps (at most {} s, safety {})", scene.duration,
-                          scene.adaptive->max, scene.adaptive->safety)
-            : fmt::format("{} steps of {} s", scene.steps, scene.dt);
+        !scene.adaptive ? fmt::format("{} steps of {} s", scene.steps, scene.dt)
+        : scene.adaptive->random
+            ? fmt::format("{} s in random steps of {} to {} s (seed {})", scene.duration,
+                          scene.adaptive->min, scene.adaptive->max, scene.adaptive->seed)
+            : fmt::format("{} s in adaptive steps (at most {} s, safety {})", scene.duration,
+                          scene.adaptive->max, scene.adaptive->safety);
     fmt::print("{}: {} x {} nodes, {} with {}, {} rank{} ({} x {} blocks) x {} threads -> {}\n",
                scene.title.empty() ? scene.name : scene.title, scene.m, scene.n, steps,
                integrator_name(scene.integrator), ranks, ranks == 1 ? "" : "s",
@@ -421,9 +423,14 @@ int run(const RunOptions& options, int rank, int ranks) {
                  failure->step, failure->time, describe(*failure), simulation.step_index(),
                  output);
     if (rank == 0 && !failure->solver_failure) {
-      const CflEstimate cfl =
-          cosserat::rest_step_estimate(scene.model_spec());
-      if (scene.adaptive)
+      const CflEstimate cfl = cosserat::rest_step_estimate(scene.model_spec());
+      if (scene.adaptive && scene.adaptive->random)
+        fmt::print(stderr,
+                   "hint: this run's random steps reach time.dt.max = {} s; the rest sheet's "
+                   "CFL estimate is {:.3g} s (docs/stability.md, \"Random steps\"): keep max "
+                   "below it\n",
+                   scene.adaptive->max, cfl.dt);
+      else if (scene.adaptive)
         fmt::print(stderr,
                    "hint: adaptive steps went down to time.dt.min = {:.3g} s (the rest sheet's "
                    "CFL estimate is {:.3g} s): a failure no step cures is a property of the "

@@ -189,6 +189,18 @@ std::optional<std::string> read_adaptive_state(const hdf5::File& file, const std
     return fmt::format("checkpoint '{}': its last step {} s or its roll-back factor {} is not "
                        "a step or a factor in (0, 1]",
                        path, state.last_dt, state.scale);
+  // A random sequence continues bitwise only as the same seed's between the same bounds.
+  const bool random = file.has_attribute("random_seed");
+  const AdaptiveStep& steps = *scene.adaptive;
+  if (random != steps.random ||
+      (random && (file.read_int_attribute("random_seed") !=
+                      static_cast<long>(steps.seed) ||
+                  file.read_double_attribute("dt_min") != steps.min)))
+    return fmt::format("checkpoint '{}' was written with other variable steps than this "
+                       "scene's ({})",
+                       path, steps.random ? fmt::format("random, seed {}, {} to {} s", steps.seed,
+                                                        steps.min, steps.max)
+                                          : "adaptive");
   return std::nullopt;
 }
 
@@ -306,6 +318,10 @@ void write_checkpoint(const std::string& path, Simulation& simulation, const Sce
       // Adaptive steps continue bitwise only from the same step history and roll-back factor.
       file.write_attribute("last_dt", simulation.stepper().last_dt());
       file.write_attribute("adaptive_scale", adaptive_scale.value_or(1.0));
+      if (scene.adaptive->random) {
+        file.write_attribute("random_seed", static_cast<std::int64_t>(scene.adaptive->seed));
+        file.write_attribute("dt_min", scene.adaptive->min);
+      }
     }
     const std::vector<hsize_t> shape{static_cast<hsize_t>(b.m), static_cast<hsize_t>(b.n), 3};
     for (const Stepper::StateField& f : simulation.stepper().state_fields()) {

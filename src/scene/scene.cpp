@@ -371,9 +371,9 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
   for (const char* fixed_only : {"steps", "output_every"}) {
     if (const auto entry = time.find(fixed_only)) {
       entry->fail(fmt::format(
-          "counts fixed steps, and this scene's steps are adaptive ({}); give time.duration and "
+          "counts fixed steps, and this scene's steps vary ({}); give time.duration and "
           "time.output_dt in seconds, or a fixed step time.dt = <seconds>",
-          dt ? "time.dt is a table" : "it gives no time.dt"));
+          dt ? "time.dt is a table" : "it gives no time.dt: adaptive steps"));
     }
   }
   switch (scene.integrator) {
@@ -381,8 +381,8 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
     case Integrator::verlet_lagged:
     case Integrator::semi_implicit: {
       const std::string why = fmt::format(
-          "the {} integrator assumes a constant step; adaptive steps work with verlet, "
-          "tc-verlet, symplectic-euler, euler, midpoint, rk4 and velocity-verlet",
+          "the {} integrator assumes a constant step; variable steps (adaptive or random) work "
+          "with verlet, tc-verlet, symplectic-euler, euler, midpoint, rk4 and velocity-verlet",
           integrator_name(scene.integrator));
       if (dt) dt->fail(why);
       time.missing("dt", "a fixed step in seconds: " + why);
@@ -396,10 +396,35 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
   AdaptiveStep adaptive;
   adaptive.max = scene.output_dt;
   if (dt) {
-    dt->allow({"adaptive", "min", "max", "safety"});
+    dt->allow({"adaptive", "sequence", "min", "max", "safety", "seed"});
+    if (const auto sequence = dt->find("sequence")) {
+      const std::string name = sequence->string();
+      if (name != "random") {
+        sequence->fail(fmt::format("unknown step sequence \"{}\"; allowed: random (steps that "
+                                   "follow the state are adaptive = true)",
+                                   name));
+      }
+      for (const char* adaptive_only : {"adaptive", "safety"})
+        if (const auto entry = dt->find(adaptive_only))
+          entry->fail("belongs to adaptive steps; random steps take min, max and seed");
+      adaptive.random = true;
+      adaptive.max = positive(dt->require("max", "the longest step in seconds"));
+      adaptive.min = positive(dt->require("min", "the shortest step in seconds"));
+      if (adaptive.min > adaptive.max)
+        dt->require("min", "").fail(fmt::format("must be <= time.dt.max ({} s), got {}",
+                                                adaptive.max, adaptive.min));
+      if (const auto seed = dt->find("seed"))
+        adaptive.seed = static_cast<std::uint64_t>(integer_at_least(*seed, 0));
+      scene.dt = adaptive.max;
+      const double most = std::ceil(scene.duration / adaptive.min);
+      scene.steps = most < 9e18 ? static_cast<long>(most) : std::numeric_limits<long>::max();
+      scene.adaptive = adaptive;
+      return;
+    }
     const Entry flag = dt->require("adaptive", "true (a fixed step is a number: time.dt = 0.001)");
     if (!flag.boolean()) {
-      flag.fail("a fixed step is a number (time.dt = 0.001); a table means adaptive = true");
+      flag.fail("a fixed step is a number (time.dt = 0.001); a table means adaptive = true or "
+                "sequence = \"random\"");
     }
     if (const auto max = dt->find("max")) adaptive.max = positive(*max);
     if (const auto safety = dt->find("safety")) {
@@ -411,8 +436,7 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
     }
   }
   // The rest sheet's CFL step sets the scale of the smallest step worth taking.
-  const CflEstimate cfl =
-      rest_step_estimate(scene.model_spec());
+  const CflEstimate cfl = rest_step_estimate(scene.model_spec());
   adaptive.min = 1e-6 * std::min(adaptive.max, adaptive.safety * cfl.dt);
   if (dt)
     if (const auto min = dt->find("min")) {

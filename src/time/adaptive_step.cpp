@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "cosserat/model/force_model.hpp"
 
@@ -53,7 +54,9 @@ double AdaptiveSteps::frame_at_or_before(double time) const {
 // it reads swings with them, so the step swung at their frequency (sphere_drape over 10 s:
 // energy rose in 131 of 334 frames, by up to 0.015 J, and nodes chattered at 2 m/s; at a fixed
 // step of the same length, or by this rule, it rose in a few frames by at most 1e-5 J).
-AdaptiveSteps::Next AdaptiveSteps::next(double time, double last_dt, double estimate) const {
+AdaptiveSteps::Next AdaptiveSteps::next(double time, double last_dt, double estimate,
+                                        long step) const {
+  if (settings_.random) return random_step(time, step);
   const double stable = scale_ * settings_.safety * estimate;
   const auto bounded = [&](double dt) {
     return std::max(std::min(dt, settings_.max), settings_.min);
@@ -75,7 +78,27 @@ AdaptiveSteps::Next AdaptiveSteps::next(double time, double last_dt, double esti
   return Next{dt, time + dt, false};
 }
 
+// docs/stability.md, "Random steps": step n's length from the seed and n alone (SplitMix64 of
+// the two, uniform in [min, max]), so that every rank, thread count and restart draws the same
+// sequence. A step is cut short to end on a frame time, or stretched to it when it would leave
+// less than min before it (or, where that would pass max, the step is half of what is left).
+AdaptiveSteps::Next AdaptiveSteps::random_step(double time, long step) const {
+  std::uint64_t x = settings_.seed + 0x9E3779B97F4A7C15ULL * (static_cast<std::uint64_t>(step) + 1);
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+  x ^= x >> 31;
+  const double unit = static_cast<double>(x >> 11) * 0x1.0p-53;
+  const double dt = settings_.min + unit * (settings_.max - settings_.min);
+  const double target = frame_after(time);
+  const double left = target - time;
+  if (dt >= left || (left - dt < settings_.min && left <= settings_.max))
+    return Next{left, target, true};
+  if (left - dt < settings_.min) return Next{0.5 * left, time + 0.5 * left, false};
+  return Next{dt, time + dt, false};
+}
+
 bool AdaptiveSteps::shrink(double failed_dt) {
+  if (settings_.random) return false;
   scale_ *= 0.5;
   return 0.5 * failed_dt >= settings_.min;
 }

@@ -58,8 +58,11 @@ void adaptive_steps(Simulation& simulation, const Scene& scene, const StepLoopOp
   std::optional<Stepper::Snapshot> older;
   Stepper::Snapshot newer = stepper.snapshot();
   while (simulation.time() < scene.duration && simulation.step_index() < scene.steps) {
-    const double estimate = stability_estimate(scene, simulation.state_measures());
-    const AdaptiveSteps::Next next = steps.next(simulation.time(), stepper.last_dt(), estimate);
+    // The estimate is a global reduction over the state: only steps that follow it pay for it.
+    const double estimate =
+        steps.follows_estimate() ? stability_estimate(scene, simulation.state_measures()) : 0.0;
+    const AdaptiveSteps::Next next =
+        steps.next(simulation.time(), stepper.last_dt(), estimate, simulation.step_index());
     const auto started = Clock::now();
     auto failure = stepper.step(next.dt, next.end_time);
     tuner.record(seconds_since(started));

@@ -11,10 +11,12 @@
 namespace cosserat {
 
 namespace {
-// The scene's step, or the first adaptive one: what the rest sheet at its initial velocity
-// allows. The schemes build the history of their first step with it.
+// The scene's step, the first of a random sequence, or the first adaptive one: what the rest
+// sheet at its initial velocity allows. The schemes build the history of their first step
+// with it.
 double first_step(const Scene& scene) {
   if (!scene.adaptive) return scene.dt;
+  if (scene.adaptive->random) return AdaptiveSteps(scene).next(0.0, 0.0, 0.0, 0).dt;
   const StateMeasures rest{1.0, std::sqrt(dot(scene.initial_velocity, scene.initial_velocity))};
   const AdaptiveStep& a = *scene.adaptive;
   return std::max(a.min, std::min(a.max, a.safety * stability_estimate(scene, rest)));

@@ -6,6 +6,7 @@
 #include <mpi.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -145,6 +146,23 @@ end_time = 0.05
 )",
                             "rolling_back.toml");
   scene.integrator = integrator;
+  return scene;
+}
+
+// The rolling-back scene for 0.1 s in random steps (docs/stability.md, "Random steps") of a
+// tenth to four tenths of its rest sheet's CFL step, seed 11: stable, so nothing rolls back,
+// and every step a length of its own (about 800 of them).
+inline Scene random_steps_scene(Integrator integrator) {
+  Scene scene = rolling_back_scene(integrator);
+  scene.duration = 0.1;
+  const double cfl = rest_step_estimate(scene.model_spec()).dt;
+  AdaptiveStep& steps = *scene.adaptive;
+  steps.random = true;
+  steps.seed = 11;
+  steps.min = 0.1 * cfl;
+  steps.max = 0.4 * cfl;
+  scene.dt = steps.max;
+  scene.steps = static_cast<long>(std::ceil(scene.duration / steps.min));
   return scene;
 }
 

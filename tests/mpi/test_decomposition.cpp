@@ -270,6 +270,30 @@ TEST(DecompositionInvariance, AdaptiveStepsAndTheirRollBacksFollowTheOneBlockRun
   }
 }
 
+// Random steps are the seed's on every split: the same steps and the same trajectory, bitwise,
+// for a scheme of each state kind.
+TEST(DecompositionInvariance, RandomStepsFollowTheOneBlockRun) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::rk4}) {
+    const Scene scene = testing::random_steps_scene(integrator);
+    const std::string what = integrator_name(integrator);
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+    testing::Silent silent;
+    const StepLoopResult expected = run_step_loop(reference, scene, {}, silent);
+    ASSERT_FALSE(expected.failure) << what;
+    ASSERT_TRUE(expected.adaptive);
+    EXPECT_LT(expected.adaptive->smallest_dt, expected.adaptive->largest_dt) << what;
+    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+      const StepLoopResult result = run_step_loop(sim, scene, {}, silent);
+      ASSERT_FALSE(result.failure);
+      EXPECT_EQ(sim.step_index(), reference.step_index()) << what << ", " << split_name(d);
+      EXPECT_EQ(result.adaptive->smallest_dt, expected.adaptive->smallest_dt) << split_name(d);
+      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+          << what << ", split " << split_name(d);
+    }
+  }
+}
+
 // Contact with a free body (docs/contact.md, "Parallel runs, restarts and output"): contacts on
 // owned nodes and cells, the body's impulse sums in one global order, so the cloth and the body
 // follow the one-block run bitwise on every split, for a scheme of each state kind.

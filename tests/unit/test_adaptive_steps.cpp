@@ -2,9 +2,12 @@
 // at fixed simulated times, the roll-back when the monitor trips, and the failure below
 // time.dt.min. Decomposition invariance and restarts are in tests/mpi.
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -93,6 +96,102 @@ TEST(AdaptiveScene, StepCountsAndUnfitIntegratorsAreRefusedWithTheKey) {
   }
 }
 
+// Random steps (docs/stability.md, "Random steps"): the table's bounds and seed.
+TEST(RandomScene, TableGivesTheSequence) {
+  const Scene scene = adaptive_sheet(
+      "duration = 0.5\noutput_dt = 0.1\ndt = { sequence = \"random\", min = 1e-4, max = 3e-4, "
+      "seed = 7 }");
+  ASSERT_TRUE(scene.adaptive);
+  EXPECT_TRUE(scene.adaptive->random);
+  EXPECT_EQ(scene.adaptive->min, 1e-4);
+  EXPECT_EQ(scene.adaptive->max, 3e-4);
+  EXPECT_EQ(scene.adaptive->seed, 7u);
+  EXPECT_EQ(scene.dt, 3e-4);
+  EXPECT_EQ(scene.output_dt, 0.1);
+  EXPECT_GE(static_cast<double>(scene.steps), 0.5 / 1e-4);
+}
+
+TEST(RandomScene, BadTablesAreRefusedWithTheKey) {
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"duration = 1.0\ndt = { sequence = \"gaussian\", min = 1e-4, max = 2e-4 }",
+       "time.dt.sequence"},
+      {"duration = 1.0\ndt = { sequence = \"random\", max = 2e-4 }", "time.dt.min"},
+      {"duration = 1.0\ndt = { sequence = \"random\", min = 1e-4 }", "time.dt.max"},
+      {"duration = 1.0\ndt = { sequence = \"random\", min = 3e-4, max = 2e-4 }", "time.dt.min"},
+      {"duration = 1.0\ndt = { sequence = \"random\", min = 1e-4, max = 2e-4, safety = 0.5 }",
+       "time.dt.safety"},
+      {"duration = 1.0\ndt = { sequence = \"random\", min = 1e-4, max = 2e-4, seed = -1 }",
+       "time.dt.seed"},
+      {"duration = 1.0\nintegrator = \"leapfrog\"\ndt = { sequence = \"random\", min = 1e-4, "
+       "max = 2e-4 }",
+       "time.dt"},
+      {"steps = 10\ndt = { sequence = \"random\", min = 1e-4, max = 2e-4 }", "time.steps"},
+  };
+  for (const auto& [time, key] : cases) {
+    try {
+      adaptive_sheet(time);
+      ADD_FAILURE() << "accepted: " << time;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << time << ": " << e.what();
+    }
+  }
+}
+
+// The steps a run takes, from the stepper after each.
+class StepRecorder : public Recorder {
+ public:
+  explicit StepRecorder(Simulation& simulation) : Recorder(simulation), simulation_(simulation) {}
+  void progress(long) override { steps.push_back(simulation_.stepper().last_dt()); }
+  std::vector<double> steps;
+
+ private:
+  Simulation& simulation_;
+};
+
+// A seed's sequence is the same in every run and another seed's is not; the steps spread over
+// [min, max] as a uniform draw does, end on every frame time, and no step is shorter than min,
+// the ones cut to a frame included.
+TEST(RandomSteps, AreTheSeedsAndLandOnTheirFrames) {
+  // Between a tenth and four tenths of the rest sheet's CFL step: stable.
+  const double cfl =
+      rest_step_estimate(adaptive_sheet("duration = 0.05").model_spec()).dt;
+  const double min = 0.1 * cfl, max = 0.4 * cfl;
+  const auto run = [&](std::uint64_t seed) {
+    Scene scene = adaptive_sheet(fmt::format(
+        "duration = 0.05\noutput_dt = 0.007\ndt = {{ sequence = \"random\", min = {}, "
+        "max = {}, seed = {} }}",
+        min, max, seed));
+    auto simulation = std::make_unique<Simulation>(scene, MPI_COMM_SELF);
+    StepRecorder recorder(*simulation);
+    const StepLoopResult result = run_step_loop(*simulation, scene, {}, recorder);
+    EXPECT_FALSE(result.failure);
+    EXPECT_EQ(simulation->time(), 0.05);
+    return std::make_pair(std::move(simulation), recorder);
+  };
+  const auto [first, a] = run(3);
+  const auto [again, b] = run(3);
+  const auto [other, c] = run(4);
+  EXPECT_EQ(a.steps, b.steps);
+  EXPECT_EQ(first->positions()(5, 5).y, again->positions()(5, 5).y);
+  EXPECT_NE(a.steps, c.steps);
+  std::vector<double> expected;
+  for (int j = 1; j * 0.007 < 0.05; ++j) expected.push_back(j * 0.007);
+  expected.push_back(0.05);
+  EXPECT_EQ(a.frame_times, expected);
+  double sum = 0.0, squares = 0.0;
+  for (const double dt : a.steps) {
+    EXPECT_GE(dt, min * (1.0 - 1e-12));
+    EXPECT_LE(dt, max * (1.0 + 1e-12));
+    sum += dt;
+    squares += dt * dt;
+  }
+  const double count = static_cast<double>(a.steps.size());
+  const double spread = std::sqrt(squares / count - (sum / count) * (sum / count));
+  // A uniform draw on [min, max] spreads by (max − min)/√12.
+  EXPECT_GT(spread, 0.7 * (max - min) / std::sqrt(12.0)) << spread;
+  EXPECT_LT(spread, 1.3 * (max - min) / std::sqrt(12.0)) << spread;
+}
+
 TEST(AdaptiveScene, WindowsInStepsAreRefusedAndWindowsInSecondsRead) {
   const std::string text = sheet("duration = 1.0");
   EXPECT_THROW(parse_scene(text + "[[load]]\nnodes = [[3, 3]]\nforce = [0, 1, 0]\nend = 10\n",
@@ -147,7 +246,7 @@ TEST(AdaptiveSteps, AWobblingEstimateLeavesTheStepAlone) {
   std::vector<double> taken;
   const auto step = [&] {
     const double estimate = level * (1.0 + wobble(pattern));
-    const AdaptiveSteps::Next next = steps.next(time, last, estimate);
+    const AdaptiveSteps::Next next = steps.next(time, last, estimate, 0);
     EXPECT_LE(next.dt, safety * estimate * (1.0 + 1e-12)) << "t = " << time;
     EXPECT_LE(next.dt, 1.25 * last * (1.0 + 1e-12)) << "t = " << time;
     frames += next.frame;

@@ -69,12 +69,16 @@ struct Load {
   Window window;
 };
 
-// time.dt = { adaptive = true, ... }, or no time.dt: the step follows the stability estimate of
-// the current state (docs/stability.md, "Adaptive steps").
+// Variable steps. time.dt = { adaptive = true, ... }, or no time.dt: the step follows the
+// stability estimate of the current state (docs/stability.md, "Adaptive steps").
+// time.dt = { sequence = "random", min, max, seed }: each step drawn from [min, max], the same
+// for every run of the seed (docs/stability.md, "Random steps").
 struct AdaptiveStep {
   double min = 0.0;     // s; a run that needs a smaller step is unstable (exit 3)
   double max = 0.0;     // s
   double safety = 0.5;  // the fraction of the estimate taken
+  bool random = false;  // the steps are the seed's random sequence, not the estimate's
+  std::uint64_t seed = 0;
 };
 
 // Gusts on top of the mean wind: a sum of random Fourier modes drawn from the seed

@@ -30,12 +30,16 @@ class AdaptiveSteps {
     double end_time;  // time + dt, or exactly the frame time the step was cut to reach
     bool frame;       // the step ends at a frame time (the last one is the duration)
   };
-  // The step from `time`, after a step of `last_dt`, for a state estimated at `estimate`.
-  Next next(double time, double last_dt, double estimate) const;
+  // Step `step` (counted from the run's start), from `time`, after a step of `last_dt`, for a
+  // state estimated at `estimate`; random steps read neither the estimate nor the last step.
+  Next next(double time, double last_dt, double estimate, long step) const;
+
+  // Whether the steps follow the state's estimate (random ones do not, and never roll back).
+  bool follows_estimate() const { return !settings_.random; }
 
   // A step of `failed_dt` tripped the monitor: from now on the run takes half of what it took
-  // of the estimate. False when half the failed step is below time.dt.min: the run is
-  // unstable. The factor never grows back: an estimate that was too large once is so by a
+  // of the estimate. False when half the failed step is below time.dt.min, or the steps are
+  // random (the sequence is the seed's): the run is unstable. The factor never grows back: an estimate that was too large once is so by a
   // factor the state carries on (a fold, a stiffer bending mode), and growing back would only
   // repeat the roll-back.
   bool shrink(double failed_dt);
@@ -47,6 +51,7 @@ class AdaptiveSteps {
 
  private:
   double frame_index(double time) const;
+  Next random_step(double time, long step) const;
   // The first frame time after `time`: j x output_dt, or the duration.
   double frame_after(double time) const;
 
