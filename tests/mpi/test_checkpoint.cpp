@@ -179,6 +179,32 @@ void overwrite(const std::string& file, const std::string& dataset, std::vector<
   MPI_Barrier(MPI_COMM_WORLD);
 }
 
+// A random sequence continues only as itself: a checkpoint of one seed or one shortest step is
+// refused by a scene of another (they would continue bitwise but as another run), and by a scene
+// of adaptive steps.
+TEST_F(Restart, RefusesACheckpointOfAnotherStepSequence) {
+  const std::string checkpoint = (folder_ / "random.checkpoint.h5").string();
+  const Scene scene = testing::random_steps_scene(Integrator::verlet);
+  {
+    Simulation sim(scene, MPI_COMM_WORLD, any_scheme);
+    ASSERT_TRUE(testing::advance(sim, 5));
+    write_checkpoint(checkpoint, sim, scene, "test");
+  }
+  Scene other_seed = scene;
+  other_seed.adaptive->seed += 1;
+  Scene other_min = scene;
+  other_min.adaptive->min *= 0.5;
+  Scene adaptive = scene;
+  adaptive.adaptive->random = false;
+  for (const Scene& other : {other_seed, other_min, adaptive}) {
+    Simulation sim(other, MPI_COMM_WORLD, any_scheme);
+    EXPECT_THROW(read_checkpoint(checkpoint, sim, other), CheckpointError);
+  }
+  Simulation same(scene, MPI_COMM_WORLD, any_scheme);
+  EXPECT_EQ(read_checkpoint(checkpoint, same, scene), 5);
+  MPI_Barrier(MPI_COMM_WORLD);
+}
+
 // Issue 12, defect 12: what a checkpoint holds is checked before a restart uses it, and every
 // rank refuses alike, even where the bad value lies in one rank's block. Before, a NaN started
 // the run and constraints outside the grid or of no fix were ignored.
