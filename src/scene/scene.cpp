@@ -24,7 +24,7 @@
 #include <string_view>
 
 #include "checked_toml.hpp"
-#include "cosserat/model/force_model.hpp"
+#include "cosserat/model/model_spec.hpp"
 #include "overrides.hpp"
 #include "solids.hpp"
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "cosserat/model/force_model.hpp"
+#include "cosserat/model/model_spec.hpp"
 
 namespace cosserat {
 

@@ -66,6 +66,15 @@ damping = 0.2
 )";
 }
 
+// The scene's flat rest grid, origin + k h1 u + l h2 v, at every node of `block`'s range that
+// is on the grid (ghosts included).
+inline Field<Vec3> rest_positions(const Scene& s, const Block& block) {
+  Field<Vec3> r(block);
+  for (int l = 0; l < s.n; ++l)
+    for (int k = 0; k < s.m; ++k) r(k, l) = s.origin + (k * s.h1()) * s.u + (l * s.h2()) * s.v;
+  return r;
+}
+
 inline Fix fix_nodes(std::vector<NodeIndex> nodes) {
   Fix f;
   f.nodes.nodes = std::move(nodes);

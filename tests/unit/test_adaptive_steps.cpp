@@ -42,6 +42,18 @@ class Recorder : public StepObserver {
   const Simulation& simulation_;
 };
 
+// Each [time] section is refused, the message naming its key.
+void expect_refused(const std::vector<std::pair<std::string, std::string>>& cases) {
+  for (const auto& [time, key] : cases) {
+    try {
+      adaptive_sheet(time);
+      ADD_FAILURE() << "accepted: " << time;
+    } catch (const SceneError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << time << ": " << e.what();
+    }
+  }
+}
+
 TEST(AdaptiveScene, NoStepMeansAdaptiveWithDefaults) {
   const Scene scene = adaptive_sheet("duration = 0.5");
   ASSERT_TRUE(scene.adaptive);
@@ -87,14 +99,7 @@ TEST(AdaptiveScene, StepCountsAndUnfitIntegratorsAreRefusedWithTheKey) {
       {"duration = 1.0\ndt = { adaptive = true, step = 0.01 }", "time.dt.step"},
       {"duration = 1.0\ndt = 0.01\nsteps = 100", "time.duration"},
   };
-  for (const auto& [time, key] : cases) {
-    try {
-      adaptive_sheet(time);
-      ADD_FAILURE() << "accepted: " << time;
-    } catch (const SceneError& e) {
-      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << time << ": " << e.what();
-    }
-  }
+  expect_refused(cases);
 }
 
 // Random steps (docs/stability.md, "Random steps"): the table's bounds and seed.
@@ -128,14 +133,7 @@ TEST(RandomScene, BadTablesAreRefusedWithTheKey) {
        "time.dt"},
       {"steps = 10\ndt = { sequence = \"random\", min = 1e-4, max = 2e-4 }", "time.steps"},
   };
-  for (const auto& [time, key] : cases) {
-    try {
-      adaptive_sheet(time);
-      ADD_FAILURE() << "accepted: " << time;
-    } catch (const SceneError& e) {
-      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << time << ": " << e.what();
-    }
-  }
+  expect_refused(cases);
 }
 
 // The steps a run takes, from the stepper after each.

@@ -15,13 +15,6 @@
 namespace cosserat {
 namespace {
 
-Field<Vec3> rest_positions(const Scene& s, const Block& block) {
-  Field<Vec3> r(block);
-  for (int l = 0; l < s.n; ++l)
-    for (int k = 0; k < s.m; ++k) r(k, l) = s.origin + (k * s.h1()) * s.u + (l * s.h2()) * s.v;
-  return r;
-}
-
 class EveryForm : public ::testing::TestWithParam<Discretisation> {};
 
 TEST_P(EveryForm, SaysWhatItIs) {
@@ -49,7 +42,7 @@ TEST_P(EveryForm, SaysWhatItIs) {
   EXPECT_NEAR(total, expected, 1e-12 * expected);
 
   // At rest: no internal force, so the acceleration is gravity alone, and no stored energy.
-  const Field<Vec3> r = rest_positions(scene, block);
+  const Field<Vec3> r = testing::rest_positions(scene, block);
   const Vec3 g{0.0, -9.81, 0.0};
   Field<Vec3> a(block);
   model->free_acceleration(r, g, a, nullptr);

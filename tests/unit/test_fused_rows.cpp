@@ -14,13 +14,6 @@
 namespace cosserat {
 namespace {
 
-Field<Vec3> rest_positions(const Scene& s, const Block& block) {
-  Field<Vec3> r(block);
-  for (int l = 0; l < s.n; ++l)
-    for (int k = 0; k < s.m; ++k) r(k, l) = s.origin + (k * s.h1()) * s.u + (l * s.h2()) * s.v;
-  return r;
-}
-
 bool same_bits(const Vec3& a, const Vec3& b) { return std::memcmp(&a, &b, sizeof(Vec3)) == 0; }
 
 TEST(FusedRows, AreTheFieldsAccelerationBitForBit) {
@@ -35,11 +28,11 @@ TEST(FusedRows, AreTheFieldsAccelerationBitForBit) {
   ended.window.end = 4;
   scene.loads = {first, second, ended};
   const Block block = Block::whole(scene.m, scene.n, MPI_COMM_SELF);
-  Dynamics dynamics(scene, block, rest_positions(scene, block));
+  Dynamics dynamics(scene, block, testing::rest_positions(scene, block));
   ASSERT_TRUE(dynamics.fuses_rows());
   Scene without_loads = scene;
   without_loads.loads.clear();
-  Dynamics unloaded_dynamics(without_loads, block, rest_positions(scene, block));
+  Dynamics unloaded_dynamics(without_loads, block, testing::rest_positions(scene, block));
 
   Field<Vec3> r(block);
   for (int l = 0; l < scene.n; ++l)

@@ -9,23 +9,10 @@
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/vec3.hpp"
-#include "cosserat/model/borders.hpp"
-#include "cosserat/model/material.hpp"
+#include "cosserat/model/model_spec.hpp"
 #include "cosserat/model/node_mass.hpp"
-#include "cosserat/model/wave_speed.hpp"
 
 namespace cosserat {
-
-// What a model is built from: the scene's model keys, its material and its grid's spacings and
-// directions (Scene::model_spec gives it).
-struct ModelSpec {
-  Discretisation discretisation = Discretisation::energy;
-  Borders borders = Borders::symmetric;
-  Material material;
-  double h1 = 0.0, h2 = 0.0;  // m
-  Vec3 u{1.0, 0.0, 0.0}, v{0.0, 0.0, 1.0};
-  double density = 0.0;  // μ0, kg/m²
-};
 
 class ForceModel {
  public:
@@ -70,11 +57,6 @@ class ForceModel {
 std::unique_ptr<ForceModel> make_force_model(const ModelSpec& spec, const Block& block,
                                              double rest_area);
 
-// The explicit step the model allows on the flat rest sheet (s), with the wave speeds behind
-// it: known before any model is built (scene validation, `cosserat stable-dt`).
-CflEstimate rest_step_estimate(const ModelSpec& spec);
-// The same for a sheet whose edges are stretched by up to √stretch2 (adaptive steps).
-double stretched_step_estimate(const ModelSpec& spec, double stretch2);
 // The bytes a node of the model's force kernel keeps beside the positions (memory estimates).
 double kernel_bytes_per_node(const ModelSpec& spec);
 

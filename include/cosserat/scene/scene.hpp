@@ -12,7 +12,7 @@
 
 #include "cosserat/contact/solid.hpp"
 #include "cosserat/model/borders.hpp"
-#include "cosserat/model/force_model.hpp"
+#include "cosserat/model/model_spec.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/time/integrator.hpp"

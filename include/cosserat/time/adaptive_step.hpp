@@ -16,7 +16,7 @@ struct StateMeasures {
 };
 
 // The step the state allows, before the safety factor: the force model's for its stretched
-// edges (stretched_step_estimate, model/force_model.hpp), and no more than a quarter of the
+// edges (stretched_step_estimate, model/model_spec.hpp), and no more than a quarter of the
 // smaller spacing per step at the fastest node (half of what the monitor allows).
 double stability_estimate(const Scene& scene, const StateMeasures& state);
 
