@@ -1308,7 +1308,8 @@ void Contact::cell_pass(int pass, std::size_t solid, const Field<Vec3>& current,
       if (product > 0.0) r = std::max(r, a * b2 * c / std::sqrt(product));
     }
     if (r >= offset_radius) return flat_offset;
-    const double sag = r * r / (offset_radius + std::sqrt((offset_radius - r) * (offset_radius + r)));
+    const double sag =
+        r * r / (offset_radius + std::sqrt((offset_radius - r) * (offset_radius + r)));
     return std::min(flat_offset, thickness - sag);
   };
   const double radius = g.bounding_radius();

@@ -409,29 +409,23 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
           entry->fail("belongs to adaptive steps; random steps take min, max and seed");
       adaptive.random = true;
       adaptive.max = positive(dt->require("max", "the longest step in seconds"));
-      adaptive.min = positive(dt->require("min", "the shortest step in seconds"));
-      if (adaptive.min > adaptive.max)
-        dt->require("min", "").fail(fmt::format("must be <= time.dt.max ({} s), got {}",
-                                                adaptive.max, adaptive.min));
+      dt->require("min", "the shortest step in seconds");
       if (const auto seed = dt->find("seed"))
         adaptive.seed = static_cast<std::uint64_t>(integer_at_least(*seed, 0));
-      scene.dt = adaptive.max;
-      const double most = std::ceil(scene.duration / adaptive.min);
-      scene.steps = most < 9e18 ? static_cast<long>(most) : std::numeric_limits<long>::max();
-      scene.adaptive = adaptive;
-      return;
-    }
-    const Entry flag = dt->require("adaptive", "true (a fixed step is a number: time.dt = 0.001)");
-    if (!flag.boolean()) {
-      flag.fail("a fixed step is a number (time.dt = 0.001); a table means adaptive = true or "
-                "sequence = \"random\"");
-    }
-    if (const auto max = dt->find("max")) adaptive.max = positive(*max);
-    if (const auto safety = dt->find("safety")) {
-      adaptive.safety = positive(*safety);
-      if (adaptive.safety > 1.0) {
-        safety->fail(fmt::format("must be in (0, 1], a fraction of the stability estimate; "
-                                 "got {}", adaptive.safety));
+    } else {
+      const Entry flag =
+          dt->require("adaptive", "true (a fixed step is a number: time.dt = 0.001)");
+      if (!flag.boolean()) {
+        flag.fail("a fixed step is a number (time.dt = 0.001); a table means adaptive = true or "
+                  "sequence = \"random\"");
+      }
+      if (const auto max = dt->find("max")) adaptive.max = positive(*max);
+      if (const auto safety = dt->find("safety")) {
+        adaptive.safety = positive(*safety);
+        if (adaptive.safety > 1.0) {
+          safety->fail(fmt::format("must be in (0, 1], a fraction of the stability estimate; "
+                                   "got {}", adaptive.safety));
+        }
       }
     }
   }

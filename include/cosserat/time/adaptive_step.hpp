@@ -39,9 +39,9 @@ class AdaptiveSteps {
 
   // A step of `failed_dt` tripped the monitor: from now on the run takes half of what it took
   // of the estimate. False when half the failed step is below time.dt.min, or the steps are
-  // random (the sequence is the seed's): the run is unstable. The factor never grows back: an estimate that was too large once is so by a
-  // factor the state carries on (a fold, a stiffer bending mode), and growing back would only
-  // repeat the roll-back.
+  // random (the sequence is the seed's): the run is unstable. The factor never grows back: an
+  // estimate that was too large once is so by a factor the state carries on (a fold, a stiffer
+  // bending mode), and growing back would only repeat the roll-back.
   bool shrink(double failed_dt);
 
   double scale() const { return scale_; }
