@@ -371,6 +371,31 @@ class Sheet:
             self.frames[frame] = self.run.cloth(frame, self.rows, self.columns)
         return self.frames[frame]
 
+    def torn(self, frame):
+        """Per drawn cell [rows - 1, columns - 1], whether a spring across it is broken
+        (/fields/broken_springs of a mass-spring run, docs/output.md "Fields"): such a cell is
+        left out, so a tear shows as a hole. None when the run tore nothing."""
+        stored = self.run.stored_field("broken_springs")
+        if stored is None:
+            return None
+        bits = np.asarray(stored[frame]).astype(np.int64)
+        if not bits.any():
+            return None
+        # A node's bits 0-3: its springs to (k+1, l), (k, l+1), (k+1, l+1), and from (k, l) to
+        # (k+1, l-1), which crosses cell (k, l-1). Cell (k, l) holds the first three of its corner
+        # (k, l), 0 of (k, l+1), 1 of (k+1, l) and 3 of (k, l+1).
+        def bit(slot):
+            return (bits >> slot) & 1 == 1
+        cell = (bit(0)[:-1, :-1] | bit(1)[:-1, :-1] | bit(2)[:-1, :-1] | bit(0)[:-1, 1:]
+                | bit(1)[1:, :-1] | bit(3)[:-1, 1:])
+        # A drawn cell spans the grid cells between its thinned rows and columns.
+        torn = np.zeros((len(self.rows) - 1, len(self.columns) - 1), dtype=bool)
+        for i in range(len(self.rows) - 1):
+            for j in range(len(self.columns) - 1):
+                torn[i, j] = cell[self.rows[i]:self.rows[i + 1],
+                                  self.columns[j]:self.columns[j + 1]].any()
+        return torn
+
     def values(self, frame):
         """The field's cell values [m - 1, n - 1] at `frame`, the means of their corners': from
         the field the run wrote (STORED) when the file holds it, else computed from the
@@ -527,14 +552,18 @@ class Picture:
         colours[..., :3] *= shade[..., None]
         return colours
 
-    def show(self, frame, points, values, full, solids, title):
+    def show(self, frame, points, values, full, solids, title, torn=None):
         """Draw `frame`: its thinned nodes `points`, the field's cell `values`, the whole frame
-        `full` (the marks sit on nodes the thinning may leave out) and the solids' surfaces."""
+        `full` (the marks sit on nodes the thinning may leave out) and the solids' surfaces;
+        the cells `torn` marks are left out."""
         for artist in self.artists:
             artist.remove()
         quads = np.stack([points[:-1, :-1], points[1:, :-1], points[1:, 1:], points[:-1, 1:]],
                          axis=2).reshape(-1, 4, 3)
         colours = self.cloth_colours(points, values).reshape(-1, 4)
+        if torn is not None:
+            kept = ~torn.reshape(-1)
+            quads, colours = quads[kept], colours[kept]
         # Each cloth facet is edged in its own colour: antialiasing alone leaves hairline
         # seams between neighbouring facets, through which the back of the cloth shows.
         edges = np.tile(to_rgba(MESH_COLOUR), (len(quads), 1)) if self.mesh else colours
@@ -721,7 +750,8 @@ def render(arguments, run):
     def show(picture, frame, most_deformed):
         picture.show(frame, sheet.points(frame), values[frame], run.cloth(frame),
                      run.solid_surfaces(frame),
-                     arguments.title or default_title(run, frame, most_deformed))
+                     arguments.title or default_title(run, frame, most_deformed),
+                     sheet.torn(frame))
 
     def picture_of(frames):
         """A picture laid out for these frames (their colour scale), showing the first."""

@@ -9,6 +9,7 @@ NodeField node_field(OutputField field) {
     case OutputField::area_ratio: return {output_field_name(field), "1", false};
     case OutputField::curvature: return {output_field_name(field), "1/m", false};
     case OutputField::energy_density: return {output_field_name(field), "J/m^2", false};
+    case OutputField::broken_springs: return {output_field_name(field), "1", false};
   }
   return {};
 }

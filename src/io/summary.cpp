@@ -72,7 +72,9 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
   if (loop.failure) summary.unstable_step = loop.failure->step;
   summary.area_ratio = diagnostics.area_ratio;
   summary.max_speed = diagnostics.max_speed;
-  summary.discretisation = discretisation_name(scene.discretisation);
+  summary.discretisation = scene.model_kind == ModelKind::mass_spring
+                               ? model_kind_name(scene.model_kind)
+                               : discretisation_name(scene.discretisation);
   summary.kinetic_energy = diagnostics.kinetic_energy;
   summary.elastic_energy = simulation.elastic_energy();
   summary.gravitational_energy = diagnostics.gravitational_energy;

@@ -8,11 +8,32 @@
 
 #include "cosserat/model/cosserat_energy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/model/mass_spring.hpp"
 
 namespace cosserat {
 
 void ForceModel::free_acceleration_rows(const Field<Vec3>&, const Vec3&, const RowConsumer&) {
   throw std::logic_error("ForceModel::free_acceleration_rows: this model has no row walk");
+}
+
+void ForceModel::velocity_acceleration(const Field<Vec3>&, const Field<Vec3>&,
+                                       Field<Vec3>&) const {
+  throw std::logic_error("ForceModel::velocity_acceleration: this model has no velocity force");
+}
+
+bool ForceModel::act_on_step(const Field<Vec3>&, const Field<Vec3>&, Field<Vec3>&, bool) {
+  throw std::logic_error("ForceModel::act_on_step: this model does not act on steps");
+}
+
+void ForceModel::restore_step_state(const std::vector<double>& state) {
+  if (!state.empty())
+    throw std::invalid_argument("the checkpoint holds a model state this model does not have");
+}
+
+void ForceModel::broken_springs(Field<double>& bits) const {
+  const Block& b = bits.block();
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) bits(k, l) = 0.0;
 }
 
 namespace {
@@ -116,7 +137,9 @@ class FluxForm final : public CosseratForm {
 std::unique_ptr<ForceModel> make_force_model(const ModelSpec& spec, const Block& block,
                                              double rest_area) {
   std::unique_ptr<ForceModel> model;
-  if (is_energy_form(spec.discretisation))
+  if (spec.kind == ModelKind::mass_spring)
+    model = std::make_unique<MassSpring>(spec, block);
+  else if (is_energy_form(spec.discretisation))
     model = std::make_unique<EnergyForm>(spec, block, rest_area);
   else
     model = std::make_unique<FluxForm>(spec, block, rest_area);
@@ -128,8 +151,10 @@ std::unique_ptr<ForceModel> make_force_model(const ModelSpec& spec, const Block&
 }
 
 double kernel_bytes_per_node(const ModelSpec& spec) {
-  // The flux form keeps its resultants and two tractions per node; the energy form only row
-  // buffers (docs/kernel.md, "Memory"), counted with the threads.
+  // The mass-spring model keeps a byte of broken springs per node; the flux form its
+  // resultants and two tractions; the energy form only row buffers (docs/kernel.md,
+  // "Memory"), counted with the threads.
+  if (spec.kind == ModelKind::mass_spring) return 1.0;
   return is_energy_form(spec.discretisation)
              ? 0.0
              : static_cast<double>(sizeof(NodeResultants) + 2 * sizeof(Vec3));

@@ -189,7 +189,44 @@ void warn_of_overridden_preset(const Table& material, const Entry& preset, Scene
       preset.where(), preset.key(), name, joined(overriding), effect, name));
 }
 
+// The mass-spring model's material is its particles' mass alone: the total, the areal
+// density or each particle's; its stiffness is in [model] (docs/scene-format.md, "Keys").
+void read_particle_mass(const Table& material, Scene& scene) {
+  for (const std::string_view name : {"preset", "zeta", "xi", "phi"})
+    if (const auto given = material.find(name))
+      given->fail(
+          "the mass-spring model takes no Cosserat material; give mass, density or "
+          "particle_mass here and the springs' ke and kd in [model]");
+  material.allow({"mass", "density", "particle_mass"});
+  const double nodes = static_cast<double>(scene.m) * scene.n;
+  const auto mass = material.find("mass");
+  const auto density = material.find("density");
+  const auto particle = material.find("particle_mass");
+  if ((mass ? 1 : 0) + (density ? 1 : 0) + (particle ? 1 : 0) > 1)
+    material.fail("give one of mass (total kg), density (kg/m^2) or particle_mass (kg)");
+  // Compared before multiplying: an overflow would trap in a build with FPE traps on.
+  auto times = [](const Entry& entry, double factor) {
+    const double value = positive(entry);
+    if (!(value <= std::numeric_limits<double>::max() / factor))
+      entry.fail(fmt::format("{} x {} is not a finite mass", value, factor));
+    return value * factor;
+  };
+  if (mass) {
+    scene.material.mass = positive(*mass);
+  } else if (density) {
+    scene.material.mass = times(*density, scene.size1 * scene.size2);
+  } else if (particle) {
+    scene.material.mass = times(*particle, nodes);
+  } else {
+    material.missing("mass", "mass (total kg), density (kg/m^2) or particle_mass (kg)");
+  }
+}
+
 void read_material(const Table& material, Scene& scene) {
+  if (scene.model_kind == ModelKind::mass_spring) {
+    read_particle_mass(material, scene);
+    return;
+  }
   material.allow({"preset", "mass", "density", "zeta", "xi", "phi"});
   const double area = scene.size1 * scene.size2;
 
@@ -226,14 +263,66 @@ void read_material(const Table& material, Scene& scene) {
   if (preset) warn_of_overridden_preset(material, *preset_entry, scene);
 }
 
+SpringFamily read_spring_family(const Table& family) {
+  family.allow({"ke", "kd"});
+  SpringFamily springs;
+  springs.ke = non_negative(family.require("ke", "the springs' stiffness in N/m, >= 0"));
+  if (const auto kd = family.find("kd")) springs.kd = non_negative(*kd);
+  return springs;
+}
+
+// [model] of kind "mass-spring" (docs/scene-format.md, "Keys"): the three families and the
+// options of docs/model.md, "The mass-spring model", lengths in rest lengths.
+void read_springs(const Table& model, Scene& scene) {
+  for (const std::string_view name : {"discretisation", "borders"})
+    if (const auto given = model.find(name))
+      given->fail("belongs to the Cosserat model; the mass-spring model has none");
+  model.allow({"kind", "structural", "shear", "bend", "dead_zone", "min_length", "max_length",
+               "rupture_length"});
+  SpringSpec& springs = scene.springs;
+  const char* what = "a table { ke = N/m, kd = N s/m }";
+  springs.structural = read_spring_family(model.require_table("structural", what));
+  if (const auto shear = model.find_table("shear")) springs.shear = read_spring_family(*shear);
+  if (const auto bend = model.find_table("bend")) springs.bend = read_spring_family(*bend);
+  if (!(springs.structural.ke > 0.0))
+    model.fail("model.structural.ke must be > 0: without it the sheet holds no shape");
+  if (const auto zone = model.find("dead_zone")) {
+    springs.dead_zone = non_negative(*zone);
+    if (springs.dead_zone >= 1.0)
+      zone->fail(fmt::format("must be < 1 (a fraction of the rest length), got {}",
+                             springs.dead_zone));
+  }
+  if (const auto least = model.find("min_length")) {
+    springs.min_length = non_negative(*least);
+    if (springs.min_length >= 1.0)
+      least->fail(fmt::format("must be < 1 (in rest lengths), got {}", springs.min_length));
+  }
+  if (const auto most = model.find("max_length")) {
+    springs.max_length = positive(*most);
+    if (springs.max_length <= 1.0)
+      most->fail(fmt::format("must be > 1 (in rest lengths), got {}", springs.max_length));
+  }
+  if (const auto rupture = model.find("rupture_length")) {
+    springs.rupture_length = positive(*rupture);
+    if (springs.rupture_length <= 1.0)
+      rupture->fail(
+          fmt::format("must be > 1 (in rest lengths), got {}", springs.rupture_length));
+  }
+}
+
 void read_model(const Table& model, Scene& scene) {
-  model.allow({"kind", "discretisation", "borders"});
   if (const auto kind = model.find("kind")) {
     const std::string name = kind->string();
+    if (name == "mass-spring") {
+      scene.model_kind = ModelKind::mass_spring;
+      read_springs(model, scene);
+      return;
+    }
     if (name != "cosserat") {
-      kind->fail(fmt::format("unknown model \"{}\"; allowed: cosserat", name));
+      kind->fail(fmt::format("unknown model \"{}\"; allowed: cosserat, mass-spring", name));
     }
   }
+  model.allow({"kind", "discretisation", "borders"});
   if (const auto borders = model.find("borders")) {
     const std::string name = borders->string();
     if (name == "symmetric") {
@@ -463,6 +552,14 @@ void read_time(const Table& time, Scene& scene) {
           "(install libpetsc-real-dev and configure with -DCOSSERAT_WITH_PETSC=ON)");
     }
 #endif
+    const SpringSpec& springs = scene.springs;
+    if (*integrator == Integrator::semi_implicit && scene.model_kind == ModelKind::mass_spring &&
+        (springs.structural.kd > 0.0 || springs.shear.kd > 0.0 || springs.bend.kd > 0.0)) {
+      entry->fail(
+          "the semi-implicit baseline does not treat the springs' damping kd; use verlet, "
+          "which solves for it at the step's centre (docs/model.md, \"Damping along the "
+          "springs\"), or kd = 0");
+    }
     scene.integrator = *integrator;
   }
   if (const auto solver = time.find_table("solver")) {
@@ -644,7 +741,9 @@ NodeSet read_node_set(const Table& block, const Scene& scene) {
 // Inclusive windows in steps and in seconds; the ends default to the end of the run.
 Window read_window(const Table& block, const Scene& scene) {
   Window window;
-  if (scene.adaptive) {
+  // A random sequence takes no step back, so its step indices are the seed's alone and a
+  // window may count them; adaptive steps' indices depend on the rollbacks.
+  if (scene.adaptive && !scene.adaptive->random) {
     for (const char* in_steps : {"start", "end"})
       if (const auto entry = block.find(in_steps)) {
         entry->fail(fmt::format("counts steps, and this scene's steps are adaptive; give "
@@ -782,16 +881,19 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   if (const auto title = root.find("title")) scene.title = title->string();
   // Grid first: the material's mass and every node set depend on it.
   read_grid(root.require_table("grid", "a [grid] table with nodes and size"), scene);
+  // The model before the material: the mass-spring model's material is its mass alone.
+  if (const auto model = root.find_table("model")) read_model(*model, scene);
   read_material(root.require_table("material",
                                    "a [material] table with a preset, or zeta, xi, "
                                    "phi and mass or density"),
                 scene);
-  if (const auto model = root.find_table("model")) read_model(*model, scene);
   if (const auto environment = root.find_table("environment")) {
     read_environment(*environment, scene);
   }
   read_time(root.require_table("time", "a [time] table with dt and steps, or a duration"), scene);
   read_output(root.find_table("output"), scene);
+  if (scene.model_kind == ModelKind::mass_spring && std::isfinite(scene.springs.rupture_length))
+    scene.output_fields.push_back(OutputField::broken_springs);
   if (const auto fixes = root.find("fix")) {
     for (const auto& block : fixes->tables("fix")) scene.fixes.push_back(read_fix(block, scene));
   }
@@ -801,8 +903,10 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   // Every integrator takes solids, the semi-implicit one too: contact acts on each accepted
   // step, after the scheme, whatever the scheme.
   if (const auto solids = root.find("solid")) scene.solids = read_solids(*solids, scene);
-  warn_if_not_positive_definite(origin, scene);
-  warn_if_folds_unresolved(origin, scene);
+  if (scene.model_kind == ModelKind::cosserat) {
+    warn_if_not_positive_definite(origin, scene);
+    warn_if_folds_unresolved(origin, scene);
+  }
 }
 
 }  // namespace
@@ -813,6 +917,7 @@ const char* output_field_name(OutputField field) {
     case OutputField::area_ratio: return "area_ratio";
     case OutputField::curvature: return "curvature";
     case OutputField::energy_density: return "energy_density";
+    case OutputField::broken_springs: return "broken_springs";
   }
   return "";
 }

@@ -38,6 +38,11 @@ class Leapfrog final : public VelocityScheme {
   using VelocityScheme::VelocityScheme;
   void start(Field<Vec3> velocities) override;
   std::optional<std::string> advance(long step) override;
+
+ private:
+  void damped_springs_velocity(double c, double d);
+
+  Field<Vec3> spring_force_;  // K(v^{n−½}), with a velocity force only
 };
 
 // euler: r⁺ = r + Δt v, v⁺ = v + Δt A(r, v). symplectic-euler: v⁺ first, then r⁺ = r + Δt v⁺.

@@ -34,6 +34,55 @@ Field<Vec3> Simulation::initial_velocities(const Scene& scene, const Block& bloc
   return v;
 }
 
+// What the force model does to every proposed step (the mass-spring model's rupture and
+// length limits, docs/model.md "The mass-spring model"), before the contact, which has the last
+// word on where nodes go. A node it moves moves on with the velocity the move implies: the
+// Verlet family's r⁻ stays, so (r⁺ − r⁻)/Δt takes it in; a scheme that carries velocities adds
+// move/Δt.
+class Simulation::ModelAction final : public StepAction {
+ public:
+  ModelAction(ForceModel& model, Halo& halo, const Constraints& constraints, const Block& block)
+      : model_(&model),
+        halo_(&halo),
+        constraints_(&constraints),
+        block_(&block),
+        held_(block),
+        moves_(block) {}
+
+  void apply(ProposedStep& p) override {
+    const Block& b = *block_;
+    for (const Constraints::NodeState& node : constraints_->state())
+      if (b.owns(node.k, node.l)) held_(node.k, node.l).x = node.held != 0 ? 1.0 : 0.0;
+    halo_->exchange(held_);
+    const double rate = 1.0 / p.dt;
+    Field<Vec3>* velocities = p.next_velocities;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      halo_->exchange(p.next_positions);
+      int moved = model_->act_on_step(p.next_positions, held_, moves_, pass == 0) ? 1 : 0;
+      MPI_Allreduce(MPI_IN_PLACE, &moved, 1, MPI_INT, MPI_MAX, b.comm);
+      if (moved == 0) break;
+      for_owned(b, [&](int k, int l) {
+        p.next_positions(k, l) += moves_(k, l);
+        if (velocities != nullptr) (*velocities)(k, l) += rate * moves_(k, l);
+      });
+    }
+  }
+  std::vector<double> state() const override { return model_->step_state(); }
+  // Each pass of the length limits corrects a node by the mean of what its springs ask, which
+  // never overshoots but leaves part of a correction shared with neighbours to the next pass
+  // (docs/model.md, "The mass-spring model").
+  static constexpr int kPasses = 8;
+  void restore(const std::vector<double>& values) override { model_->restore_step_state(values); }
+
+ private:
+  ForceModel* model_;
+  Halo* halo_;
+  const Constraints* constraints_;
+  const Block* block_;
+  Field<Vec3> held_;   // x: 1 at a node held in some component, ghosts included
+  Field<Vec3> moves_;  // the model's moves of the owned nodes
+};
+
 // docs/contact.md: the scene's solids against every proposed step, whatever the scheme; the run's
 // maxima kept over accepted steps.
 class Simulation::ContactAction final : public StepAction, public RowReader {
@@ -87,13 +136,16 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
       decomposition_(decomposition),
       block_(decomposition_.block(rank_in(comm), comm)),
       halo_(decomposition_, block_, rank_in(comm)),
-      dynamics_(scene, block_, rest_positions(scene, block_)),
+      dynamics_(scene, block_, rest_positions(scene, block_), &halo_),
       contact_(scene.solids.empty()
                    ? nullptr
                    : std::make_unique<Contact>(scene.solids, block_, halo_, dynamics_.node_mass(),
                                                scene.gravity, std::min(scene.h1(), scene.h2()))),
       stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),
                initial_velocities(scene, block_), make) {
+  if (dynamics_.model().acts_on_steps())
+    stepper_.add_action(
+        std::make_unique<ModelAction>(dynamics_.model(), halo_, stepper_.constraints(), block_));
   if (contact_) {
     auto action = std::make_unique<ContactAction>(*contact_);
     contact_action_ = action.get();
@@ -138,6 +190,9 @@ void Simulation::node_field(OutputField field, Field<double>& values) const {
       return;
     case OutputField::energy_density:
       dynamics_.energy_density(r, values);
+      return;
+    case OutputField::broken_springs:
+      dynamics_.model().broken_springs(values);
       return;
     case OutputField::velocity:
       break;

@@ -129,17 +129,21 @@ std::optional<Instability> Stepper::check(const Field<Vec3>& next, double end_ti
   const double limit2 = max_move_ * max_move_;
   const long none = std::numeric_limits<long>::max();
   // Written so that a NaN also fails.
-  auto too_far = [&](const Vec3& move, int k, int l) {
-    const Vec3 neighbour = next(k, l) - r(k, l);
+  // Neighbours a torn model parted (a broken spring) may fly apart.
+  const ForceModel& model = dynamics_->model();
+  auto too_far = [&](const Vec3& move, int k, int l, int k2, int l2) {
+    if (model.parted(k, l, k2, l2)) return false;
+    const Vec3 neighbour = next(k2, l2) - r(k2, l2);
     const Vec3 relative = move - neighbour;
     return !(dot(relative, relative) <= limit2) && !(dot(move, move) < dot(neighbour, neighbour));
   };
   auto fails = [&](int k, int l) {
     const Vec3 p = next(k, l);
     const Vec3 move = p - r(k, l);
-    return !is_finite(p) || (k > 0 && too_far(move, k - 1, l)) ||
-           (k + 1 < b.m && too_far(move, k + 1, l)) || (l > 0 && too_far(move, k, l - 1)) ||
-           (l + 1 < b.n && too_far(move, k, l + 1));
+    return !is_finite(p) || (k > 0 && too_far(move, k, l, k - 1, l)) ||
+           (k + 1 < b.m && too_far(move, k, l, k + 1, l)) ||
+           (l > 0 && too_far(move, k, l, k, l - 1)) ||
+           (l + 1 < b.n && too_far(move, k, l, k, l + 1));
   };
   // A node fails only if one of its edges changed by more than the limit, or its position is
   // not finite (and then every edge of it fails the edge test too): only a row with such an

@@ -31,23 +31,52 @@ std::optional<std::string> Leapfrog::advance(long step) {
   const double dt = context_.dt;
   const double c = 0.5 * dt * terms.damping;
   const double d = 0.5 * dt * terms.fluid;
-  for_owned(context_.block, [&](int k, int l) {
-    const Vec3 v = velocity_(k, l);
-    Vec3 rhs = (1.0 - c) * v + dt * acceleration_(k, l);
-    if (d > 0.0) {
-      const Vec3 n = (*n_field)(k, l);
-      rhs -= (d * dot(n, v)) * n;
-      next_velocity_(k, l) = solve_centred(rhs, n, c, d);
-    } else {
-      next_velocity_(k, l) = rhs / (1.0 + c);
-    }
-  });
+  if (context_.dynamics.has_velocity_force()) {
+    damped_springs_velocity(c, d);
+  } else {
+    for_owned(context_.block, [&](int k, int l) {
+      const Vec3 v = velocity_(k, l);
+      Vec3 rhs = (1.0 - c) * v + dt * acceleration_(k, l);
+      if (d > 0.0) {
+        const Vec3 n = (*n_field)(k, l);
+        rhs -= (d * dot(n, v)) * n;
+        next_velocity_(k, l) = solve_centred(rhs, n, c, d);
+      } else {
+        next_velocity_(k, l) = rhs / (1.0 + c);
+      }
+    });
+  }
   context_.constraints.hold_velocities(next_velocity_);
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) = positions_(k, l) + dt * next_velocity_(k, l);
   });
   context_.constraints.hold_positions(next_positions_, context_.end_time);
   return std::nullopt;
+}
+
+// v^{n+½} with the springs' damping at the mean velocity: (1 + c) w + d (n·w) n − (Δt/2) K(w)
+// = (1 − c) v − d (n·v) n + Δt a + (Δt/2) K(v), solved from the first guess v (a held component
+// at its held velocity).
+void Leapfrog::damped_springs_velocity(double c, double d) {
+  const double dt = context_.dt;
+  const double s = 0.5 * dt;
+  Dynamics& dynamics = context_.dynamics;
+  const Field<Vec3>* n_field = normals();
+  if (spring_force_.data() == nullptr) spring_force_ = Field<Vec3>(context_.block);
+  dynamics.velocity_acceleration(positions_, velocity_, spring_force_);
+  for_owned(context_.block, [&](int k, int l) {
+    const Vec3 v = velocity_(k, l);
+    Vec3 rhs = (1.0 - c) * v + dt * acceleration_(k, l) + s * spring_force_(k, l);
+    if (d > 0.0) {
+      const Vec3 n = (*n_field)(k, l);
+      rhs -= (d * dot(n, v)) * n;
+    }
+    acceleration_(k, l) = rhs;
+    next_velocity_(k, l) = v;
+  });
+  context_.constraints.hold_velocities(next_velocity_);
+  dynamics.solve_velocity_terms(positions_, n_field, c, d, s, acceleration_,
+                                context_.constraints.state(), next_velocity_);
 }
 
 std::optional<std::string> Euler::advance(long step) {

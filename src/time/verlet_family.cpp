@@ -96,6 +96,10 @@ void VerletFamily::centred_step(long step) {
       dynamics.free_acceleration(positions_, step, acceleration_, n_field);
   const double c = terms.damping * weight / span;
   const double d = terms.fluid * weight / span;
+  if (dynamics.has_velocity_force()) {
+    damped_springs_step(weight, ratio, span, c, d);
+    return;
+  }
   // Two loops rather than a test per node, so that each vectorises.
   if (d > 0.0) {
     for_owned(context_.block, [&](int k, int l) {
@@ -111,6 +115,35 @@ void VerletFamily::centred_step(long step) {
           update(positions_(k, l), previous_positions_(k, l), acceleration_(k, l), c);
     });
   }
+  context_.constraints.hold_positions(next_positions_, context_.end_time);
+}
+
+// The centred step when the model's force depends on the velocities (springs damped along
+// themselves): the centred velocity v = (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁) couples neighbours, so it is
+// solved for (Dynamics::solve_velocity_terms) rather than found node by node, from the first
+// guess (r − r⁻)/Δtₙ₋₁; a held component's is where its hold takes it.
+void VerletFamily::damped_springs_step(double weight, double ratio, double span, double c,
+                                       double d) {
+  if (centred_velocity_.data() == nullptr) centred_velocity_ = Field<Vec3>(context_.block);
+  const double dt_previous = dt_previous_;
+  for_owned(context_.block, [&](int k, int l) {
+    const Vec3 r = positions_(k, l), rp = previous_positions_(k, l);
+    acceleration_(k, l) = (r + ratio * (r - rp) + weight * acceleration_(k, l) - rp) / span;
+    centred_velocity_(k, l) = (r - rp) / dt_previous;
+  });
+  const std::vector<Constraints::NodeState> held = context_.constraints.state();
+  for (const Constraints::NodeState& node : held)
+    if (context_.block.owns(node.k, node.l))
+      for (int axis = 0; axis < 3; ++axis)
+        if ((node.held >> axis) & 1u)
+          centred_velocity_(node.k, node.l)[axis] =
+              (node.position(axis, context_.end_time) - previous_positions_(node.k, node.l)[axis]) /
+              span;
+  context_.dynamics.solve_velocity_terms(positions_, normals(), c, d, weight / span,
+                                         acceleration_, held, centred_velocity_);
+  for_owned(context_.block, [&](int k, int l) {
+    next_positions_(k, l) = previous_positions_(k, l) + span * centred_velocity_(k, l);
+  });
   context_.constraints.hold_positions(next_positions_, context_.end_time);
 }
 

@@ -36,7 +36,7 @@ struct RunSummary {
   std::optional<long> unstable_step;
   double area_ratio = 0.0;  // S / S0 at the end
   double max_speed = 0.0;
-  std::string discretisation;  // "energy", "energy-nodal" or "flux"
+  std::string discretisation;  // "energy", "energy-nodal", "flux", or "mass-spring" (that model)
   double kinetic_energy = 0.0;
   double elastic_energy = 0.0;        // E of docs/equations.md §2.5 (for the flux form too)
   double gravitational_energy = 0.0;  // −Σ m g·r

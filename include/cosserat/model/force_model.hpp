@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/vec3.hpp"
@@ -36,6 +37,44 @@ class ForceModel {
   // free_acceleration's a, each row to `consume` in place of the field: the same bits.
   virtual void free_acceleration_rows(const Field<Vec3>& r, const Vec3& gravity,
                                       const RowConsumer& consume);
+
+  // The part of the internal force linear in the velocities, −D(r) v with D symmetric and
+  // positive semidefinite (the mass-spring model's damping along its springs): whether there is
+  // one, its acceleration −M⁻¹D(r) v into `a` at every owned node (reads the ghosts of r and v
+  // up to reach() nodes out), and a bound on the largest eigenvalue of M⁻¹D (1/s), whatever r.
+  virtual bool has_velocity_force() const { return false; }
+  virtual void velocity_acceleration(const Field<Vec3>& r, const Field<Vec3>& v,
+                                     Field<Vec3>& a) const;
+  virtual double velocity_force_bound() const { return 0.0; }
+
+  // What a point load of one newton at node (k, l) accelerates it by (1/kg), for a sheet of
+  // inverse areal density `inverse_density` (m²/kg) and grid cell h1 h2: over the node's share
+  // of the sheet's mass, unless the model's particles carry masses of their own.
+  virtual double load_inverse_mass(int k, int l, double inverse_density, double h1h2) const {
+    return inverse_density / (h1h2 * node_mass().weight(k, l));
+  }
+
+  // What the model does to each proposed step (the mass-spring model's rupture and length
+  // limits, docs/model.md "The mass-spring model"): whether it does anything; then, in passes
+  // over the proposed positions r⁺ with their ghosts, it changes its state in the first
+  // (collective over the block's communicator) and writes into `moves` the displacement it
+  // gives each owned node, none to a node whose `held` x is nonzero (ghosts included). Returns
+  // whether it moved a node of this block; the caller adds the moves and passes again while
+  // any block's did.
+  virtual bool acts_on_steps() const { return false; }
+  virtual bool act_on_step(const Field<Vec3>& next, const Field<Vec3>& held, Field<Vec3>& moves,
+                           bool first_pass);
+  // That state, the same on every rank, as numbers (snapshots and checkpoints), and back.
+  virtual std::vector<double> step_state() const { return {}; }
+  virtual void restore_step_state(const std::vector<double>& state);
+
+  // At every owned node, the bits of the springs that start there and are broken (the mass-spring
+  // model's slots, docs/output.md "Fields"); 0 for a model without springs.
+  virtual void broken_springs(Field<double>& bits) const;
+
+  // Whether the grid neighbours (k, l) and (k2, l2) have parted (the spring between them broke):
+  // the stability check lets them move apart.
+  virtual bool parted(int /*k*/, int /*l*/, int /*k2*/, int /*l2*/) const { return false; }
 
   // Whether the areal density the velocity terms and loads act on follows the current area
   // (μ = M/S) rather than staying the rest one (μ0 = M/S0).

@@ -2,12 +2,36 @@
 // What a force model is built from, and the explicit step it allows, known before any model is
 // built (docs/model.md, "Force models"). Free of MPI and the grid, as the scene loader is.
 
+#include <limits>
+
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/model/borders.hpp"
 #include "cosserat/model/material.hpp"
 #include "cosserat/model/wave_speed.hpp"
 
 namespace cosserat {
+
+enum class ModelKind { cosserat, mass_spring };
+
+// As written in scene files and the run summary.
+inline const char* model_kind_name(ModelKind kind) {
+  return kind == ModelKind::mass_spring ? "mass-spring" : "cosserat";
+}
+
+// One family of the mass-spring model's springs (docs/model.md, "The mass-spring model").
+struct SpringFamily {
+  double ke = 0.0;  // stiffness, N/m
+  double kd = 0.0;  // damping along the spring, N s/m
+};
+
+// The mass-spring model's keys. Lengths are in units of each spring's rest length.
+struct SpringSpec {
+  SpringFamily structural, shear, bend;
+  double dead_zone = 0.0;  // no elastic force while |ℓ − ℓ0| < dead_zone ℓ0
+  double min_length = 0.0;
+  double max_length = std::numeric_limits<double>::infinity();
+  double rupture_length = std::numeric_limits<double>::infinity();
+};
 
 // The scene's model keys, its material and its grid's spacings and directions
 // (Scene::model_spec gives it).
@@ -18,10 +42,14 @@ struct ModelSpec {
   double h1 = 0.0, h2 = 0.0;  // m
   Vec3 u{1.0, 0.0, 0.0}, v{0.0, 0.0, 1.0};
   double density = 0.0;  // μ0, kg/m²
+  ModelKind kind = ModelKind::cosserat;
+  SpringSpec springs;          // mass-spring only
+  double particle_mass = 0.0;  // kg, the mass of every node; mass-spring only
 };
 
 // The explicit step the model allows on the flat rest sheet (s), with the wave speeds behind
-// it (scene validation, `cosserat stable-dt`).
+// it (scene validation, `cosserat stable-dt`). For the mass-spring model the speeds are those
+// of the structural springs and the step is the bound of docs/model.md, "Its step".
 CflEstimate rest_step_estimate(const ModelSpec& spec);
 // The same for a sheet whose edges are stretched by up to √stretch2 (adaptive steps).
 double stretched_step_estimate(const ModelSpec& spec, double stretch2);

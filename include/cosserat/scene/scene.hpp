@@ -110,7 +110,9 @@ struct LinearSolver {
 
 // The per-node fields a run can write beside its positions (docs/output.md, "Fields"), in the
 // order they are written.
-enum class OutputField { velocity, area_ratio, curvature, energy_density };
+// broken_springs is no choice of [output]: a mass-spring scene that can tear writes it always
+// (docs/output.md, "Fields").
+enum class OutputField { velocity, area_ratio, curvature, energy_density, broken_springs };
 
 // As written in scene files and as the datasets /fields/<name> are named.
 const char* output_field_name(OutputField field);
@@ -141,6 +143,8 @@ struct Scene {
   Material material;
 
   // [model]
+  ModelKind model_kind = ModelKind::cosserat;
+  SpringSpec springs;  // mass-spring only
   Discretisation discretisation = Discretisation::energy;
   Borders borders = Borders::symmetric;  // flux form only
 
@@ -182,7 +186,8 @@ struct Scene {
   double areal_density() const { return material.mass / (size1 * size2); }  // μ0, kg/m²
   // What the force model is built from (make_force_model, rest_step_estimate).
   ModelSpec model_spec() const {
-    return ModelSpec{discretisation, borders, material, h1(), h2(), u, v, areal_density()};
+    return ModelSpec{discretisation, borders, material, h1(), h2(), u, v, areal_density(),
+                     model_kind,     springs, material.mass / (static_cast<double>(m) * n)};
   }
 };
 

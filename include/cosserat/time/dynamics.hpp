@@ -7,8 +7,10 @@
 #include <vector>
 
 #include "cosserat/grid/block.hpp"
+#include "cosserat/grid/halo.hpp"
 #include "cosserat/model/force_model.hpp"
 #include "cosserat/scene/scene.hpp"
+#include "cosserat/time/constraints.hpp"
 #include "cosserat/time/gust_field.hpp"
 
 namespace cosserat {
@@ -22,7 +24,10 @@ struct VelocityTerms {
 
 class Dynamics {
  public:
-  Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions);
+  // `halo` exchanges the velocities' ghosts for a model whose force reads its neighbours'
+  // velocities (has_velocity_force); it may be null for a block that is the whole grid.
+  Dynamics(const Scene& scene, const Block& block, const Field<Vec3>& rest_positions,
+           Halo* halo = nullptr);
 
   // The velocity-free part of the acceleration at `step` into `a`, and the coefficients of
   // the velocity terms, for schemes that treat those at the step's centre. `normals` receives
@@ -42,6 +47,25 @@ class Dynamics {
   // it there. The same bits as free_acceleration's; with fuses_rows() only.
   void free_acceleration_rows(const Field<Vec3>& r, long step,
                               const ForceModel::RowConsumer& consume);
+
+  // Whether the model's own force depends on the velocities (the mass-spring model's damping
+  // along its springs): then the schemes that treat the velocity terms at the step's centre
+  // solve for them with solve_velocity_terms.
+  bool has_velocity_force() const { return model_->has_velocity_force(); }
+
+  // Solves (1 + c) w + d (n·w) n − s K(w) = g for the velocities w at every owned node, where
+  // K(w) = −M⁻¹D(r) w is the model's velocity force over the masses (docs/model.md,
+  // "Damping along the springs"): the centred step of a scheme whose model has a velocity force.
+  // `w` holds a first guess on entry; its components held by `held` (their velocities) are
+  // kept. n are the fluid's normals (null without a fluid, where d is 0). A Chebyshev
+  // iteration over the spectrum [1, 1 + s bound] that the model's bound gives: no global
+  // reduction, so any decomposition takes the same iterates bitwise.
+  void solve_velocity_terms(const Field<Vec3>& r, const Field<Vec3>* normals, double c, double d,
+                            double s, const Field<Vec3>& g,
+                            const std::vector<Constraints::NodeState>& held, Field<Vec3>& w);
+  // The model's velocity force over the masses, −M⁻¹D(r) v, into `a` (exchanges v's ghosts:
+  // collective); with has_velocity_force() only.
+  void velocity_acceleration(const Field<Vec3>& r, const Field<Vec3>& v, Field<Vec3>& a);
 
   // The internal force's share of the acceleration, f_int/μ, into `a`: independent of S
   // (docs/equations.md §3), so a function of the positions alone. The semi-implicit baseline
@@ -63,6 +87,10 @@ class Dynamics {
   // gusts; load windows still go by the step.
   void set_stage_time(double time) { stage_time_ = time; }
 
+  // The force model, for what it does besides forces (ForceModel::act_on_step).
+  ForceModel& model() { return *model_; }
+  const ForceModel& model() const { return *model_; }
+
   bool has_fluid() const { return fluid_.has_value(); }
   // The stored energy E of docs/equations.md §2.5 (J), a global sum; reads the ghosts of r. For the
   // flux form too, whose force is not its gradient: there it shows what the discretisation
@@ -78,7 +106,9 @@ class Dynamics {
   // quadrature), M/(m n) at every node in the flux form's diagnostics.
   const NodeMass& node_mass() const { return model_->node_mass(); }
 
-  bool has_velocity_terms() const { return damping_ > 0.0 || fluid_.has_value(); }
+  bool has_velocity_terms() const {
+    return damping_ > 0.0 || fluid_.has_value() || model_->has_velocity_force();
+  }
   double rest_area() const { return rest_area_; }
   // S, a global reduction, the same bitwise for any decomposition; reads the ghosts of r.
   double total_area(const Field<Vec3>& r) const;
@@ -89,6 +119,9 @@ class Dynamics {
     Vec3 force;
     Window window;
   };
+
+  // Fills the ghosts of `field` (velocities for the velocity force).
+  void exchange(Field<Vec3>& field);
 
   // 1/μ0 = S0/M, the energy form's constant inverse areal density (docs/equations.md §2.5).
   double rest_inverse_density() const { return rest_area_ / mass_; }
@@ -105,6 +138,10 @@ class Dynamics {
   std::optional<GustField> gusts_;  // with a gust amplitude > 0 only
   std::vector<PointLoad> loads_;
   bool needs_area_;
+  Halo* halo_;
+  // The velocity force's work fields, allocated at its first use: v with its ghosts, K(v),
+  // and the Chebyshev iteration's direction and residual.
+  Field<Vec3> ghosted_velocity_, velocity_force_, direction_, residual_;
   double time_ = 0.0;
   double stage_time_ = 0.0;
 };

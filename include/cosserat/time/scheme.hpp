@@ -163,11 +163,13 @@ class VerletFamily : public Scheme {
 
  private:
   void centred_step(long step);
+  void damped_springs_step(double weight, double ratio, double span, double c, double d);
   void lagged_step(long step);
 
   bool published_;             // verlet-lagged: first-order start, velocity terms lagged
   Field<Vec3> lagged_velocity_;  // verlet-lagged: (rⁿ − rⁿ⁻¹)/Δt fed to the forces
   Field<Vec3> velocity_report_;  // what velocities() returns
+  Field<Vec3> centred_velocity_;  // (r⁺ − r⁻)/(Δtₙ + Δtₙ₋₁), with a velocity force only
   bool velocities_current_ = false;
   // The next step's r⁻ as the step's row walk wrote it (RowReader::begin_walk), allocated
   // for the first walk that sets velocities; walked_starts_: this step's walk did.

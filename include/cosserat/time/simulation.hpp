@@ -96,6 +96,7 @@ class Simulation {
   Dynamics dynamics_;
   std::unique_ptr<Contact> contact_;
   Stepper stepper_;
+  class ModelAction;
   class ContactAction;
   ContactAction* contact_action_ = nullptr;  // owned by stepper_
 };
