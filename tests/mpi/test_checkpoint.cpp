@@ -115,6 +115,24 @@ TEST_F(Restart, InGustsContinuesBitwiseOnAnotherSplitAndOnOneRank) {
     expect_restarts_bitwise(testing::gusty_odd_grid_scene(integrator));
 }
 
+// The mass-spring model's broken springs are part of the checkpoint (the model's step state):
+// springs torn before the checkpoint stay torn after it, on any split.
+TEST_F(Restart, MassSpringContinuesBitwiseOnAnotherSplitAndOnOneRank) {
+  {
+    const Scene scene = testing::mass_spring_odd_grid_scene(Integrator::verlet);
+    Simulation half(scene, MPI_COMM_SELF);
+    ASSERT_TRUE(testing::advance(half, scene.steps / 2));
+    Field<double> bits(half.block());
+    half.node_field(OutputField::broken_springs, bits);
+    int broken = 0;
+    for (int l = 0; l < scene.n; ++l)
+      for (int k = 0; k < scene.m; ++k) broken += bits(k, l) != 0.0 ? 1 : 0;
+    EXPECT_GT(broken, 0) << "nothing torn by the checkpoint";
+  }
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet})
+    expect_restarts_bitwise(testing::mass_spring_odd_grid_scene(integrator));
+}
+
 #if defined(COSSERAT_HAVE_PETSC)
 // The semi-implicit baseline keeps the Verlet family's state (rⁿ, rⁿ⁻¹) and rebuilds its
 // Jacobian from rⁿ each step, so a restart continues it too; to the linear solver's tolerance,

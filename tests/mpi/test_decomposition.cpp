@@ -155,6 +155,31 @@ TEST(DecompositionInvariance, FluxFormFollowsTheOneBlockTrajectory) {
   }
 }
 
+// The mass-spring model on every split, every integrator: its forces read the neighbours'
+// velocities through the halo, its damping solve iterates without global sums, and its
+// springs break where the block owning their first node says, for every block alike.
+TEST(DecompositionInvariance, MassSpringFollowsTheOneBlockTrajectory) {
+  {
+    // The scene tears, and its lower length limit acts: without it the run goes elsewhere.
+    const Scene scene = testing::mass_spring_odd_grid_scene(Integrator::verlet);
+    Simulation reference(scene, MPI_COMM_SELF);
+    ASSERT_TRUE(testing::advance(reference, scene.steps));
+    Field<double> bits(reference.block());
+    reference.node_field(OutputField::broken_springs, bits);
+    int broken = 0;
+    for (int l = 0; l < scene.n; ++l)
+      for (int k = 0; k < scene.m; ++k) broken += bits(k, l) != 0.0 ? 1 : 0;
+      EXPECT_GT(broken, 10);
+    Scene unlimited = scene;
+    unlimited.springs.min_length = 0.0;
+    Simulation free(unlimited, MPI_COMM_SELF);
+    ASSERT_TRUE(testing::advance(free, scene.steps));
+    EXPECT_GT(differing_nodes(free.positions(), reference.positions()), 0);
+  }
+  for (const Integrator integrator : explicit_integrators())
+    expect_every_split_follows_one_block(testing::mass_spring_odd_grid_scene(integrator));
+}
+
 // Runs `scene` on every split with one and three threads per rank and hands each run, with
 // the one-block run at the reference's thread count (OMP_NUM_THREADS) and a label, to
 // `expect`.

@@ -117,6 +117,18 @@ TEST(RandomScene, TableGivesTheSequence) {
   EXPECT_GE(static_cast<double>(scene.steps), 0.5 / 1e-4);
 }
 
+// A random sequence never steps back, so its step indices are the seed's and a window may
+// count them; adaptive steps' indices depend on their rollbacks, so there it may not.
+TEST(RandomScene, WindowsMayCountSteps) {
+  const std::string load = "\n[[load]]\nnodes = [[1, 1]]\nforce = [0.0, 0.0, 1.0]\nend = 50\n";
+  const Scene scene = parse_scene(
+      sheet("duration = 0.5\ndt = { sequence = \"random\", min = 1e-4, max = 3e-4 }") + load,
+      "sheet.toml");
+  ASSERT_EQ(scene.loads.size(), 1u);
+  EXPECT_EQ(scene.loads[0].window.end, 50);
+  EXPECT_THROW(parse_scene(sheet("duration = 0.5") + load, "sheet.toml"), SceneError);
+}
+
 TEST(RandomScene, BadTablesAreRefusedWithTheKey) {
   const std::vector<std::pair<std::string, std::string>> cases{
       {"duration = 1.0\ndt = { sequence = \"gaussian\", min = 1e-4, max = 2e-4 }",

@@ -938,11 +938,73 @@ TEST(SceneError, UnknownPreset) {
 
 TEST(SceneError, UnknownModelAndBorders) {
   SceneText text;
-  text.tail = "[model]\nkind = \"mass-spring\"\n";
-  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.kind'"), HasSubstr("allowed: cosserat")));
+  text.tail = "[model]\nkind = \"springs\"\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'model.kind'"),
+                                    HasSubstr("allowed: cosserat, mass-spring")));
   text.tail = "[model]\nborders = \"clamped\"\n";
   EXPECT_THAT(error_of(text),
               AllOf(HasSubstr("key 'model.borders'"), HasSubstr("allowed: symmetric, published")));
+}
+
+// The mass-spring model: its springs in [model], its particles' mass in [material], given as
+// the total, the areal density or each particle's; lengths in rest lengths.
+TEST(Scene, MassSpringModel) {
+  SceneText text;
+  text.material = "particle_mass = 0.01\n";
+  text.tail =
+      "[model]\nkind = \"mass-spring\"\nstructural = { ke = 4.0, kd = 0.8 }\n"
+      "bend = { ke = 1.0 }\ndead_zone = 0.001\nmax_length = 10.0\nrupture_length = 3.0\n";
+  const Scene scene = parse(text);
+  EXPECT_EQ(scene.model_kind, ModelKind::mass_spring);
+  EXPECT_DOUBLE_EQ(scene.material.mass, 0.01 * 10 * 12);
+  EXPECT_EQ(scene.springs.structural.ke, 4.0);
+  EXPECT_EQ(scene.springs.structural.kd, 0.8);
+  EXPECT_EQ(scene.springs.shear.ke, 0.0);
+  EXPECT_EQ(scene.springs.bend.ke, 1.0);
+  EXPECT_EQ(scene.springs.bend.kd, 0.0);
+  EXPECT_EQ(scene.springs.dead_zone, 0.001);
+  EXPECT_EQ(scene.springs.min_length, 0.0);
+  EXPECT_EQ(scene.springs.max_length, 10.0);
+  EXPECT_EQ(scene.springs.rupture_length, 3.0);
+  EXPECT_DOUBLE_EQ(scene.model_spec().particle_mass, 0.01);
+  text.material = "density = 2.0\n";
+  EXPECT_DOUBLE_EQ(parse(text).material.mass, 2.0 * 10.0 * 5.0);
+}
+
+TEST(SceneError, MassSpringModel) {
+  SceneText text;
+  const std::string springs = "[model]\nkind = \"mass-spring\"\nstructural = { ke = 4.0 }\n";
+  text.tail = springs;
+  // The default material is a Cosserat one.
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("material.zeta"), HasSubstr("takes no Cosserat")));
+  text.material = "mass = 1.0\nparticle_mass = 0.01\n";
+  EXPECT_THAT(error_of(text), HasSubstr("give one of mass"));
+  text.material = "mass = 1.0\n";
+  text.tail = "[model]\nkind = \"mass-spring\"\n";
+  EXPECT_THAT(error_of(text), HasSubstr("model.structural"));
+  text.tail = "[model]\nkind = \"mass-spring\"\nstructural = { ke = 0.0, kd = 1.0 }\n";
+  EXPECT_THAT(error_of(text), HasSubstr("structural.ke must be > 0"));
+  text.tail = springs + "shear = { kd = 1.0 }\n";
+  EXPECT_THAT(error_of(text), HasSubstr("model.shear.ke"));
+  text.tail = springs + "bend = { ke = -1.0 }\n";
+  EXPECT_THAT(error_of(text), HasSubstr("model.bend.ke"));
+  text.tail = springs + "discretisation = \"flux\"\n";
+  EXPECT_THAT(error_of(text), HasSubstr("belongs to the Cosserat model"));
+  text.tail = springs + "dead_zone = 1.0\n";
+  EXPECT_THAT(error_of(text), HasSubstr("must be < 1"));
+  text.tail = springs + "min_length = 1.5\n";
+  EXPECT_THAT(error_of(text), HasSubstr("must be < 1"));
+  text.tail = springs + "max_length = 0.5\n";
+  EXPECT_THAT(error_of(text), HasSubstr("must be > 1"));
+  text.tail = springs + "rupture_length = 1.0\n";
+  EXPECT_THAT(error_of(text), HasSubstr("must be > 1"));
+  text.tail = springs + "stiffness = 1.0\n";
+  EXPECT_THAT(error_of(text), HasSubstr("model.stiffness"));
+#if defined(COSSERAT_HAVE_PETSC)
+  text.tail = "[model]\nkind = \"mass-spring\"\nstructural = { ke = 4.0, kd = 0.1 }\n";
+  text.time = "integrator = \"semi-implicit\"\ndt = 0.001\nsteps = 10\n";
+  EXPECT_THAT(error_of(text), HasSubstr("does not treat the springs' damping"));
+#endif
 }
 
 // The energy form is the default; the published border rules exist in the flux form alone, so
@@ -1171,12 +1233,13 @@ TEST(Scene, DrapesWhoseGridIsCoarserThanTheirFoldsAreWarned) {
 // ---------------------------------------------------------------------------------------------
 // The shipped scenes
 
-// The reference scenes (scenes/*.toml) and the gallery (scenes/gallery/*.toml, docs/gallery.md):
-// each loads and validates without a warning (loading only, no step).
+// The reference scenes (scenes/*.toml), the gallery (scenes/gallery/*.toml, docs/gallery.md)
+// and the mass-spring scenes (scenes/springs): each loads and validates without a warning
+// (loading only, no step).
 std::vector<std::filesystem::path> shipped_scenes() {
   std::vector<std::filesystem::path> paths;
-  for (const char* folder :
-       {COSSERAT_SOURCE_DIR "/scenes", COSSERAT_SOURCE_DIR "/scenes/gallery"}) {
+  for (const char* folder : {COSSERAT_SOURCE_DIR "/scenes", COSSERAT_SOURCE_DIR "/scenes/gallery",
+                             COSSERAT_SOURCE_DIR "/scenes/springs"}) {
     for (const auto& entry : std::filesystem::directory_iterator(folder)) {
       if (entry.path().extension() == ".toml") paths.push_back(entry.path());
     }
