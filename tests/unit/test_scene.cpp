@@ -982,24 +982,22 @@ TEST(SceneError, MassSpringModel) {
   text.material = "mass = 1.0\n";
   text.tail = "[model]\nkind = \"mass-spring\"\n";
   EXPECT_THAT(error_of(text), HasSubstr("model.structural"));
-  text.tail = "[model]\nkind = \"mass-spring\"\nstructural = { ke = 0.0, kd = 1.0 }\n";
-  EXPECT_THAT(error_of(text), HasSubstr("structural.ke must be > 0"));
-  text.tail = springs + "shear = { kd = 1.0 }\n";
-  EXPECT_THAT(error_of(text), HasSubstr("model.shear.ke"));
-  text.tail = springs + "bend = { ke = -1.0 }\n";
-  EXPECT_THAT(error_of(text), HasSubstr("model.bend.ke"));
-  text.tail = springs + "discretisation = \"flux\"\n";
-  EXPECT_THAT(error_of(text), HasSubstr("belongs to the Cosserat model"));
-  text.tail = springs + "dead_zone = 1.0\n";
-  EXPECT_THAT(error_of(text), HasSubstr("must be < 1"));
-  text.tail = springs + "min_length = 1.5\n";
-  EXPECT_THAT(error_of(text), HasSubstr("must be < 1"));
-  text.tail = springs + "max_length = 0.5\n";
-  EXPECT_THAT(error_of(text), HasSubstr("must be > 1"));
-  text.tail = springs + "rupture_length = 1.0\n";
-  EXPECT_THAT(error_of(text), HasSubstr("must be > 1"));
-  text.tail = springs + "stiffness = 1.0\n";
-  EXPECT_THAT(error_of(text), HasSubstr("model.stiffness"));
+  // Each: what follows the springs' kind, and what the message must say.
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"structural = { ke = 0.0, kd = 1.0 }\n", "structural.ke must be > 0"},
+      {"structural = { ke = 4.0 }\nshear = { kd = 1.0 }\n", "model.shear.ke"},
+      {"structural = { ke = 4.0 }\nbend = { ke = -1.0 }\n", "model.bend.ke"},
+      {"structural = { ke = 4.0 }\ndiscretisation = \"flux\"\n", "belongs to the Cosserat model"},
+      {"structural = { ke = 4.0 }\ndead_zone = 1.0\n", "must be < 1"},
+      {"structural = { ke = 4.0 }\nmin_length = 1.5\n", "must be < 1"},
+      {"structural = { ke = 4.0 }\nmax_length = 0.5\n", "must be > 1"},
+      {"structural = { ke = 4.0 }\nrupture_length = 1.0\n", "must be > 1"},
+      {"structural = { ke = 4.0 }\nstiffness = 1.0\n", "model.stiffness"},
+  };
+  for (const auto& [tail, message] : cases) {
+    text.tail = "[model]\nkind = \"mass-spring\"\n" + tail;
+    EXPECT_THAT(error_of(text), HasSubstr(message)) << tail;
+  }
 #if defined(COSSERAT_HAVE_PETSC)
   text.tail = "[model]\nkind = \"mass-spring\"\nstructural = { ke = 4.0, kd = 0.1 }\n";
   text.time = "integrator = \"semi-implicit\"\ndt = 0.001\nsteps = 10\n";
