@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "cosserat/model/material.hpp"
+#include "cosserat/model/model_spec.hpp"
 
 namespace cosserat {
 namespace {
@@ -165,6 +167,36 @@ std::optional<Preset> find_preset(const std::string& name) {
                                   [&](const Preset& preset) { return preset.name == name; });
   if (found == presets.end()) return std::nullopt;
   return *found;
+}
+
+const std::vector<SpringPreset>& spring_presets() {
+  // Every family alike, as the source had them; lengths in rest lengths.
+  auto alike = [](double ke, double kd, double dead_zone, double shortest, double longest) {
+    SpringSpec s;
+    s.structural = s.shear = s.bend = SpringFamily{ke, kd};
+    s.dead_zone = dead_zone;
+    s.min_length = shortest;
+    s.max_length = longest;
+    return s;
+  };
+  constexpr double kOpen = std::numeric_limits<double>::infinity();
+  static const std::vector<SpringPreset> presets{
+      {"source-sheet", alike(4.0, 0.8, 0.001, 0.1, 10.0),
+       "the source's return-to-equilibrium sheet: 10 g particles 0.225 m apart"},
+      {"source-net", alike(100.0, 20.0, 0.0, 0.0, kOpen),
+       "the source's net that a thrown cube deforms: 15 g particles 0.225 m apart"},
+      {"source-stiff-net", alike(250.0, 50.0, 0.0, 0.0, kOpen),
+       "the source's stiffer net: 15 g particles 0.225 m apart"},
+      {"source-pressed-sheet", alike(1000.0, 200.0, 0.0, 0.0, kOpen),
+       "the source's sheet pressed onto a plane: 10 g particles 0.224 m apart"},
+  };
+  return presets;
+}
+
+std::optional<SpringPreset> find_spring_preset(const std::string& name) {
+  for (const SpringPreset& preset : spring_presets())
+    if (name == preset.name) return preset;
+  return std::nullopt;
 }
 
 }  // namespace cosserat

@@ -277,11 +277,26 @@ void read_springs(const Table& model, Scene& scene) {
   for (const std::string_view name : {"discretisation", "borders"})
     if (const auto given = model.find(name))
       given->fail("belongs to the Cosserat model; the mass-spring model has none");
-  model.allow({"kind", "structural", "shear", "bend", "dead_zone", "min_length", "max_length",
-               "rupture_length"});
+  model.allow({"kind", "preset", "structural", "shear", "bend", "dead_zone", "min_length",
+               "max_length", "rupture_length"});
   SpringSpec& springs = scene.springs;
-  const char* what = "a table { ke = N/m, kd = N s/m }";
-  springs.structural = read_spring_family(model.require_table("structural", what));
+  // A preset gives every key but rupture_length; a key beside it replaces the preset's.
+  const auto preset = model.find("preset");
+  if (preset) {
+    const std::string name = preset->string();
+    const auto found = find_spring_preset(name);
+    if (!found) {
+      std::vector<std::string> names;
+      for (const SpringPreset& p : spring_presets()) names.emplace_back(p.name);
+      preset->fail(fmt::format("unknown spring preset \"{}\"; allowed: {}", name, joined(names)));
+    }
+    springs = found->springs;
+  }
+  const char* what = "a table { ke = N/m, kd = N s/m } (or a preset)";
+  if (const auto structural = model.find_table("structural"))
+    springs.structural = read_spring_family(*structural);
+  else if (!preset)
+    model.missing("structural", what);
   if (const auto shear = model.find_table("shear")) springs.shear = read_spring_family(*shear);
   if (const auto bend = model.find_table("bend")) springs.bend = read_spring_family(*bend);
   if (!(springs.structural.ke > 0.0))

@@ -969,6 +969,22 @@ TEST(Scene, MassSpringModel) {
   EXPECT_DOUBLE_EQ(scene.model_spec().particle_mass, 0.01);
   text.material = "density = 2.0\n";
   EXPECT_DOUBLE_EQ(parse(text).material.mass, 2.0 * 10.0 * 5.0);
+
+  // A preset gives every family and option; a key beside it replaces the preset's.
+  text.tail = "[model]\nkind = \"mass-spring\"\npreset = \"source-sheet\"\nbend = { ke = 1.0 }\n";
+  const Scene preset = parse(text);
+  EXPECT_EQ(preset.springs.structural.ke, 4.0);
+  EXPECT_EQ(preset.springs.shear.kd, 0.8);
+  EXPECT_EQ(preset.springs.bend.ke, 1.0);
+  EXPECT_EQ(preset.springs.bend.kd, 0.0);
+  EXPECT_EQ(preset.springs.dead_zone, 0.001);
+  EXPECT_EQ(preset.springs.min_length, 0.1);
+  EXPECT_EQ(preset.springs.max_length, 10.0);
+  for (const SpringPreset& p : spring_presets()) {
+    text.tail = std::string("[model]\nkind = \"mass-spring\"\npreset = \"") + p.name + "\"\n";
+    EXPECT_GT(parse(text).springs.structural.ke, 0.0) << p.name;
+    EXPECT_FALSE(std::string(p.approximates).empty()) << p.name;
+  }
 }
 
 TEST(SceneError, MassSpringModel) {
@@ -993,6 +1009,7 @@ TEST(SceneError, MassSpringModel) {
       {"structural = { ke = 4.0 }\nmax_length = 0.5\n", "must be > 1"},
       {"structural = { ke = 4.0 }\nrupture_length = 1.0\n", "must be > 1"},
       {"structural = { ke = 4.0 }\nstiffness = 1.0\n", "model.stiffness"},
+      {"preset = \"source-cloth\"\n", "unknown spring preset \"source-cloth\"; allowed: source-sheet"},
   };
   for (const auto& [tail, message] : cases) {
     text.tail = "[model]\nkind = \"mass-spring\"\n" + tail;

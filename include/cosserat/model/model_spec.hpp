@@ -3,6 +3,9 @@
 // built (docs/model.md, "Force models"). Free of MPI and the grid, as the scene loader is.
 
 #include <limits>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/model/borders.hpp"
@@ -32,6 +35,17 @@ struct SpringSpec {
   double max_length = std::numeric_limits<double>::infinity();
   double rupture_length = std::numeric_limits<double>::infinity();
 };
+
+// A named set of springs (docs/model.md, "Spring presets"): the source's experiments, each for
+// the particle mass and grid it was meant for, which `approximates` says.
+struct SpringPreset {
+  const char* name;
+  SpringSpec springs;
+  const char* approximates;
+};
+
+const std::vector<SpringPreset>& spring_presets();
+std::optional<SpringPreset> find_spring_preset(const std::string& name);
 
 // The scene's model keys, its material and its grid's spacings and directions
 // (Scene::model_spec gives it).
