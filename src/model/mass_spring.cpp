@@ -12,7 +12,8 @@ namespace cosserat {
 namespace {
 
 // The owner's offsets of the six slots (MassSpring::broken).
-constexpr int kSlotOffset[MassSpring::kSlots][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}, {2, 0}, {0, 2}};
+constexpr int kSlotOffset[MassSpring::kSlots][2] = {{1, 0},  {0, 1}, {1, 1},
+                                                     {1, -1}, {2, 0}, {0, 2}};
 
 }  // namespace
 

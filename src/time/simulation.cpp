@@ -68,13 +68,14 @@ class Simulation::ModelAction final : public StepAction {
     }
   }
   std::vector<double> state() const override { return model_->step_state(); }
+  void restore(const std::vector<double>& values) override { model_->restore_step_state(values); }
+
+ private:
   // Each pass of the length limits corrects a node by the mean of what its springs ask, which
   // never overshoots but leaves part of a correction shared with neighbours to the next pass
   // (docs/model.md, "The mass-spring model").
   static constexpr int kPasses = 8;
-  void restore(const std::vector<double>& values) override { model_->restore_step_state(values); }
 
- private:
   ForceModel* model_;
   Halo* halo_;
   const Constraints* constraints_;
