@@ -1009,7 +1009,8 @@ TEST(SceneError, MassSpringModel) {
       {"structural = { ke = 4.0 }\nmax_length = 0.5\n", "must be > 1"},
       {"structural = { ke = 4.0 }\nrupture_length = 1.0\n", "must be > 1"},
       {"structural = { ke = 4.0 }\nstiffness = 1.0\n", "model.stiffness"},
-      {"preset = \"source-cloth\"\n", "unknown spring preset \"source-cloth\"; allowed: source-sheet"},
+      {"preset = \"source-cloth\"\n",
+       "unknown spring preset \"source-cloth\"; allowed: source-sheet"},
   };
   for (const auto& [tail, message] : cases) {
     text.tail = "[model]\nkind = \"mass-spring\"\n" + tail;
