@@ -189,6 +189,17 @@ void warn_of_overridden_preset(const Table& material, const Entry& preset, Scene
       preset.where(), preset.key(), name, joined(overriding), effect, name));
 }
 
+// A positive number times `factor` as a mass (kg), `product` naming the two ("density x
+// area"), `unit` the factor's. Compared before multiplying: an overflow would trap in a build
+// with FPE traps on.
+double mass_product(const Entry& entry, double factor, std::string_view product,
+                    std::string_view unit) {
+  const double value = positive(entry);
+  if (!(value <= std::numeric_limits<double>::max() / factor))
+    entry.fail(fmt::format("{} = {} x {}{} is not a finite mass", product, value, factor, unit));
+  return value * factor;
+}
+
 // The mass-spring model's material is its particles' mass alone: the total, the areal
 // density or each particle's; its stiffness is in [model] (docs/scene-format.md, "Keys").
 void read_particle_mass(const Table& material, Scene& scene) {
@@ -204,19 +215,13 @@ void read_particle_mass(const Table& material, Scene& scene) {
   const auto particle = material.find("particle_mass");
   if ((mass ? 1 : 0) + (density ? 1 : 0) + (particle ? 1 : 0) > 1)
     material.fail("give one of mass (total kg), density (kg/m^2) or particle_mass (kg)");
-  // Compared before multiplying: an overflow would trap in a build with FPE traps on.
-  auto times = [](const Entry& entry, double factor) {
-    const double value = positive(entry);
-    if (!(value <= std::numeric_limits<double>::max() / factor))
-      entry.fail(fmt::format("{} x {} is not a finite mass", value, factor));
-    return value * factor;
-  };
   if (mass) {
     scene.material.mass = positive(*mass);
   } else if (density) {
-    scene.material.mass = times(*density, scene.size1 * scene.size2);
+    scene.material.mass =
+        mass_product(*density, scene.size1 * scene.size2, "density x area", " m^2");
   } else if (particle) {
-    scene.material.mass = times(*particle, nodes);
+    scene.material.mass = mass_product(*particle, nodes, "particle_mass x nodes", "");
   } else {
     material.missing("mass", "mass (total kg), density (kg/m^2) or particle_mass (kg)");
   }
@@ -248,12 +253,7 @@ void read_material(const Table& material, Scene& scene) {
   if (mass) {
     scene.material.mass = positive(*mass);
   } else if (density) {
-    const double areal = positive(*density);
-    // Compared before multiplying: an overflow would trap in a build with FPE traps on.
-    if (!(areal <= std::numeric_limits<double>::max() / area))
-      density->fail(
-          fmt::format("density x area = {} x {} m^2 is not a finite mass", areal, area));
-    scene.material.mass = areal * area;
+    scene.material.mass = mass_product(*density, area, "density x area", " m^2");
   } else if (preset) {
     // A preset is a fabric, the same at any size: its areal density is kept.
     scene.material.mass = preset->mass * area / preset->area;

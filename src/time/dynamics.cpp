@@ -128,6 +128,7 @@ void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long ste
   const Block& b = *block_;
   const bool fluid = fluid_.has_value();
   if (model_->has_velocity_force()) {
+    if (velocity_force_.data() == nullptr) velocity_force_ = Field<Vec3>(b);
     velocity_acceleration(r, v, velocity_force_);
 #pragma omp parallel for schedule(static)
     for (int l = b.l0; l < b.l1; ++l)
@@ -148,13 +149,15 @@ void Dynamics::acceleration(const Field<Vec3>& r, const Field<Vec3>& v, long ste
 
 void Dynamics::velocity_acceleration(const Field<Vec3>& r, const Field<Vec3>& v, Field<Vec3>& a) {
   const Block& b = *block_;
-  if (ghosted_velocity_.data() == nullptr) {
-    ghosted_velocity_ = Field<Vec3>(b);
-    velocity_force_ = Field<Vec3>(b);
-  }
+  if (ghosted_velocity_.data() == nullptr) ghosted_velocity_ = Field<Vec3>(b);
   for_owned(b, [&](int k, int l) { ghosted_velocity_(k, l) = v(k, l); });
-  exchange(ghosted_velocity_);
-  model_->velocity_acceleration(r, ghosted_velocity_, a);
+  velocity_acceleration_in_place(r, ghosted_velocity_, a);
+}
+
+void Dynamics::velocity_acceleration_in_place(const Field<Vec3>& r, Field<Vec3>& v,
+                                              Field<Vec3>& a) {
+  exchange(v);
+  model_->velocity_acceleration(r, v, a);
 }
 
 void Dynamics::exchange(Field<Vec3>& field) {
@@ -181,6 +184,7 @@ void Dynamics::solve_velocity_terms(const Field<Vec3>& r, const Field<Vec3>* nor
   if (direction_.data() == nullptr) {
     direction_ = Field<Vec3>(b);
     residual_ = Field<Vec3>(b);
+    if (velocity_force_.data() == nullptr) velocity_force_ = Field<Vec3>(b);
   }
   auto solve_p = [&](const Vec3& y, int k, int l) {
     return normals != nullptr ? solve_centred(y, (*normals)(k, l), c, d) : y / (1.0 + c);
@@ -200,8 +204,8 @@ void Dynamics::solve_velocity_terms(const Field<Vec3>& r, const Field<Vec3>* nor
   constexpr double kTolerance = 1e-10;
   const int iterations =
       q > 0.0 ? static_cast<int>(std::ceil(std::log(kTolerance / 2.0) / std::log(q))) : 0;
-  // residual = P⁻¹ g − A w.
-  velocity_acceleration(r, w, velocity_force_);
+  // residual = P⁻¹ g − A w. The iteration's own fields, and w, take their ghosts in place.
+  velocity_acceleration_in_place(r, w, velocity_force_);
 #pragma omp parallel for schedule(static)
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k)
@@ -217,7 +221,7 @@ void Dynamics::solve_velocity_terms(const Field<Vec3>& r, const Field<Vec3>* nor
   for_owned(b, [&](int k, int l) { direction_(k, l) = residual_(k, l) / theta; });
   for (int it = 0; it < iterations; ++it) {
     // w += d; residual −= A d, A d = d − s P⁻¹ K(d).
-    velocity_acceleration(r, direction_, velocity_force_);
+    velocity_acceleration_in_place(r, direction_, velocity_force_);
     const double rho_next = 1.0 / (2.0 * sigma - rho);
     const double keep = rho_next * rho, gain = 2.0 * rho_next / delta;
 #pragma omp parallel for schedule(static)

@@ -122,6 +122,8 @@ class Dynamics {
 
   // Fills the ghosts of `field` (velocities for the velocity force).
   void exchange(Field<Vec3>& field);
+  // velocity_acceleration for a field whose ghosts may be filled in place: no copy.
+  void velocity_acceleration_in_place(const Field<Vec3>& r, Field<Vec3>& v, Field<Vec3>& a);
 
   // 1/μ0 = S0/M, the energy form's constant inverse areal density (docs/equations.md §2.5).
   double rest_inverse_density() const { return rest_area_ / mass_; }
@@ -139,8 +141,9 @@ class Dynamics {
   std::vector<PointLoad> loads_;
   bool needs_area_;
   Halo* halo_;
-  // The velocity force's work fields, allocated at its first use: v with its ghosts, K(v),
-  // and the Chebyshev iteration's direction and residual.
+  // The velocity force's work fields, allocated at their first use: a copy of a velocity
+  // field handed in as const, with its ghosts; K(v); the Chebyshev iteration's direction and
+  // residual.
   Field<Vec3> ghosted_velocity_, velocity_force_, direction_, residual_;
   double time_ = 0.0;
   double stage_time_ = 0.0;
