@@ -31,6 +31,37 @@ CflEstimate spring_step_estimate(const ModelSpec& spec) {
 
 }  // namespace
 
+// docs/models.md, "Matched springs". Per unit area of square cells, a small strain ε stores
+// ½ ke_st (ε₁₁² + ε₂₂²) in the structural springs, ke_sh ((ε₁₁ + ε₂₂)²/2 + 2 ε₁₂²) in the two
+// diagonals and 2 ke_b (ε₁₁² + ε₂₂²) in the bend springs; the Cosserat sheet 3 ζ (ε₁₁² + ε₂₂²)
+// + 2 ζ₁₂ ε₁₂² (docs/materials.md, "What ζ, ξ and φ measure"). So ke_sh = ζ₁₂ and ke_st + 4 ke_b
+// = 6 ζ − ζ₁₂. Bent to curvature κ across the rows, a chord of n spacings shortens by
+// n³ h³ κ²/24: the structural and shear springs then store what the Cosserat sheet's shortened
+// edges do, and the bend springs 30 ke_b h⁴ κ⁴/576 more, which is its 3 ξ κ² at κ = 1/c for
+// ke_b = 57.6 ξ c²/h⁴.
+std::optional<MatchedSprings> matched_springs(const Material& material, double density,
+                                              double h) {
+  constexpr double kStandardGravity = 9.80665;  // m/s², the bending length's (docs/materials.md)
+  const double zeta = 0.5 * (material.zeta[0] + material.zeta[2]);
+  const double shear = material.zeta[1];
+  const double xi = 0.5 * (material.xi[0] + material.xi[2]);
+  const double tension = 6.0 * zeta - shear;  // ke_st + 4 ke_b
+  if (!(tension > 0.0)) return std::nullopt;
+  MatchedSprings m;
+  double bend = 0.0;
+  if (xi > 0.0) {
+    m.bending_length = std::cbrt(6.0 * xi / (density * kStandardGravity));
+    const double c2 = m.bending_length * m.bending_length;
+    const double matching = 57.6 * xi * c2 / (h * h * h * h);
+    bend = std::min(matching, tension / 8.0);
+    m.bending_share = bend / matching;
+  }
+  m.springs.structural.ke = tension - 4.0 * bend;
+  m.springs.shear.ke = shear;
+  m.springs.bend.ke = bend;
+  return m;
+}
+
 CflEstimate rest_step_estimate(const ModelSpec& spec) {
   if (spec.kind == ModelKind::mass_spring) return spring_step_estimate(spec);
   return cfl_estimate(spec.material, spec.density, spec.h1, spec.h2);

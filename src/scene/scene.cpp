@@ -227,11 +227,7 @@ void read_particle_mass(const Table& material, Scene& scene) {
   }
 }
 
-void read_material(const Table& material, Scene& scene) {
-  if (scene.model_kind == ModelKind::mass_spring) {
-    read_particle_mass(material, scene);
-    return;
-  }
+void read_cosserat_material(const Table& material, Scene& scene) {
   material.allow({"preset", "mass", "density", "zeta", "xi", "phi"});
   const double area = scene.size1 * scene.size2;
 
@@ -263,6 +259,49 @@ void read_material(const Table& material, Scene& scene) {
   if (preset) warn_of_overridden_preset(material, *preset_entry, scene);
 }
 
+// model.match = "material" (docs/models.md, "Matched springs"): the [material] is a Cosserat
+// one, whose mass the particles take and whose ζ and ξ the springs are matched to; the
+// material then is the mass alone, as for any mass-spring scene.
+void match_springs(const Table& material, Scene& scene) {
+  read_cosserat_material(material, scene);
+  const double h1 = scene.size1 / (scene.m - 1), h2 = scene.size2 / (scene.n - 1);
+  if (std::abs(h1 - h2) > 1e-9 * std::max(h1, h2))
+    material.fail(fmt::format(
+        "model.match = \"material\" needs square cells, got h1 = {:.6g} m and h2 = {:.6g} m: "
+        "one spring stiffness per family cannot match both axes",
+        h1, h2));
+  const double density = scene.material.mass / (scene.size1 * scene.size2);
+  const Material cosserat = scene.material;
+  const auto matched = matched_springs(cosserat, density, h1);
+  if (!matched)
+    material.fail(fmt::format(
+        "model.match = \"material\": the shear resistance zeta12 = {} is at least 6 x the "
+        "mean tension resistance {}, which leaves the structural springs no stiffness",
+        cosserat.zeta[1], 0.5 * (cosserat.zeta[0] + cosserat.zeta[2])));
+  scene.springs.structural = matched->springs.structural;
+  scene.springs.shear = matched->springs.shear;
+  scene.springs.bend = matched->springs.bend;
+  if (matched->bending_share < 1.0)
+    scene.warnings.push_back(fmt::format(
+        "[material]: the matched bend springs store {:.3g} of its bending energy at its "
+        "bending length c = {:.3g} m: the grid holds {:.3g} spacings per c, and bend springs "
+        "stiff enough for all of it would carry more than half the sheet's stiffness in its "
+        "plane (docs/models.md, \"Matched springs\")",
+        matched->bending_share, matched->bending_length,
+        matched->bending_length / h1));
+  scene.material = Material{};
+  scene.material.mass = cosserat.mass;
+}
+
+void read_material(const Table& material, Scene& scene, bool springs_matched) {
+  if (scene.model_kind != ModelKind::mass_spring)
+    read_cosserat_material(material, scene);
+  else if (springs_matched)
+    match_springs(material, scene);
+  else
+    read_particle_mass(material, scene);
+}
+
 SpringFamily read_spring_family(const Table& family) {
   family.allow({"ke", "kd"});
   SpringFamily springs;
@@ -273,13 +312,24 @@ SpringFamily read_spring_family(const Table& family) {
 
 // [model] of kind "mass-spring" (docs/scene-format.md, "Keys"): the three families and the
 // options of docs/model.md, "The mass-spring model", lengths in rest lengths.
-void read_springs(const Table& model, Scene& scene) {
+// Returns whether the springs are to be matched to the material (model.match).
+bool read_springs(const Table& model, Scene& scene) {
   for (const std::string_view name : {"discretisation", "borders"})
     if (const auto given = model.find(name))
       given->fail("belongs to the Cosserat model; the mass-spring model has none");
-  model.allow({"kind", "preset", "structural", "shear", "bend", "dead_zone", "min_length",
-               "max_length", "rupture_length"});
+  model.allow({"kind", "preset", "match", "structural", "shear", "bend", "dead_zone",
+               "min_length", "max_length", "rupture_length"});
   SpringSpec& springs = scene.springs;
+  // The families from the [material] (match_springs); the options as below.
+  const auto match = model.find("match");
+  if (match) {
+    if (match->string() != "material")
+      match->fail(fmt::format("unknown match \"{}\"; allowed: material", match->string()));
+    for (const std::string_view name : {"preset", "structural", "shear", "bend"})
+      if (const auto given = model.find(name))
+        given->fail(
+            "match = \"material\" gives the three families; give either it or the springs");
+  }
   // A preset gives every key but rupture_length; a key beside it replaces the preset's.
   const auto preset = model.find("preset");
   if (preset) {
@@ -295,11 +345,11 @@ void read_springs(const Table& model, Scene& scene) {
   const char* what = "a table { ke = N/m, kd = N s/m } (or a preset)";
   if (const auto structural = model.find_table("structural"))
     springs.structural = read_spring_family(*structural);
-  else if (!preset)
+  else if (!preset && !match)
     model.missing("structural", what);
   if (const auto shear = model.find_table("shear")) springs.shear = read_spring_family(*shear);
   if (const auto bend = model.find_table("bend")) springs.bend = read_spring_family(*bend);
-  if (!(springs.structural.ke > 0.0))
+  if (!match && !(springs.structural.ke > 0.0))
     model.fail("model.structural.ke must be > 0: without it the sheet holds no shape");
   if (const auto zone = model.find("dead_zone")) {
     springs.dead_zone = non_negative(*zone);
@@ -323,15 +373,16 @@ void read_springs(const Table& model, Scene& scene) {
       rupture->fail(
           fmt::format("must be > 1 (in rest lengths), got {}", springs.rupture_length));
   }
+  return match.has_value();
 }
 
-void read_model(const Table& model, Scene& scene) {
+// Returns whether the springs are to be matched to the material (model.match).
+bool read_model(const Table& model, Scene& scene) {
   if (const auto kind = model.find("kind")) {
     const std::string name = kind->string();
     if (name == "mass-spring") {
       scene.model_kind = ModelKind::mass_spring;
-      read_springs(model, scene);
-      return;
+      return read_springs(model, scene);
     }
     if (name != "cosserat") {
       kind->fail(fmt::format("unknown model \"{}\"; allowed: cosserat, mass-spring", name));
@@ -370,6 +421,7 @@ void read_model(const Table& model, Scene& scene) {
           "default) or discretisation = \"flux\"",
           name));
   }
+  return false;
 }
 
 Gusts read_gusts(const Table& gust) {
@@ -897,11 +949,12 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   // Grid first: the material's mass and every node set depend on it.
   read_grid(root.require_table("grid", "a [grid] table with nodes and size"), scene);
   // The model before the material: the mass-spring model's material is its mass alone.
-  if (const auto model = root.find_table("model")) read_model(*model, scene);
+  bool springs_matched = false;
+  if (const auto model = root.find_table("model")) springs_matched = read_model(*model, scene);
   read_material(root.require_table("material",
                                    "a [material] table with a preset, or zeta, xi, "
                                    "phi and mass or density"),
-                scene);
+                scene, springs_matched);
   if (const auto environment = root.find_table("environment")) {
     read_environment(*environment, scene);
   }

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -157,6 +158,71 @@ TEST(MassSpring, MomentumAndRigidMotion) {
       scale += Vec3{std::abs(a(k, l).x), std::abs(a(k, l).y), std::abs(a(k, l).z)};
     }
   EXPECT_LT(norm(momentum), 1e-14 * norm(scale));
+}
+
+// Matched springs (docs/models.md, "Matched springs") store per unit area what the Cosserat sheet
+// does, read at an inside node of each model's energy density: a small stretch along x with z
+// held, a small shear, and a bend of radius c, the material's bending length. Bent to radius R,
+// both store the shortened rows' 3 ζ ε², ε = (λ² − 1)/2 for the chord's λ = 2R sin(h/2R)/h, and
+// the Cosserat sheet 3 ξ κ² with its discrete κ = 2(1 − cos(h/R)) R/h² (docs/equations.md §2.1),
+// the springs (c/R)² of that: at 2c a quarter (their bending energy goes as κ⁴). The sheet: 21 x
+// 21 nodes, 0.2 m square (h = 1 cm), μ = 0.1 kg/m², ζ = 2e4 N/m (stiff enough that the bend
+// springs need no cap), ξ for c = 0.1 m, φ = 0 (the springs have no coupling). The springs'
+// exact lengths differ from the small-strain forms by about e and (h/R)² relatively.
+TEST(MassSpring, MatchedSpringsStoreTheCosseratEnergy) {
+  Scene scene = testing::flat_sheet(21, 21);
+  scene.size1 = scene.size2 = 0.2;
+  const double h = 0.01, c = 0.1, density = 0.1;
+  scene.material.mass = density * 0.2 * 0.2;
+  scene.material.zeta = {2e4, 2e4, 2e4};
+  const double xi = c * c * c * density * 9.80665 / 6.0;
+  scene.material.xi = {xi, xi, xi};
+  scene.material.phi = {0.0, 0.0, 0.0};
+  const auto matched = matched_springs(scene.material, density, h);
+  ASSERT_TRUE(matched.has_value());
+  EXPECT_NEAR(matched->bending_length, c, 1e-15);
+  EXPECT_EQ(matched->bending_share, 1.0);
+
+  const Block block = Block::whole(scene.m, scene.n, MPI_COMM_SELF);
+  const auto cosserat = make_force_model(scene.model_spec(), block, 0.04);
+  Scene springs = scene;
+  springs.model_kind = ModelKind::mass_spring;
+  springs.springs = matched->springs;
+  const auto spring_model = make_force_model(springs.model_spec(), block, 0.04);
+
+  Field<Vec3> r(block);
+  Field<double> density_c(block), density_s(block);
+  // The two models' energy per unit area at node (10, 10).
+  const auto inside = [&](auto&& position) {
+    for (int l = 0; l < scene.n; ++l)
+      for (int k = 0; k < scene.m; ++k) r(k, l) = position(k * h, l * h);
+    cosserat->energy_density(r, density_c);
+    spring_model->energy_density(r, density_s);
+    return std::array<double, 2>{density_c(10, 10), density_s(10, 10)};
+  };
+  const double e = 1e-5;
+  const auto stretch = inside([&](double x, double z) { return Vec3{(1.0 + e) * x, 0.0, z}; });
+  EXPECT_NEAR(stretch[0], 3.0 * 2e4 * e * e, 2e-5 * stretch[0]);
+  EXPECT_NEAR(stretch[1], stretch[0], 2e-5 * stretch[0]);
+  const double gamma = 1e-5;
+  const auto shear = inside([&](double x, double z) {
+    return Vec3{x + 0.5 * gamma * z, 0.0, z + 0.5 * gamma * x};
+  });
+  EXPECT_NEAR(shear[0], 2e4 * gamma * gamma / 2.0, 1e-4 * shear[0]);
+  EXPECT_NEAR(shear[1], shear[0], 1e-4 * shear[0]);
+  for (const double radius : {c, 2.0 * c}) {
+    SCOPED_TRACE(radius);
+    const auto bent = inside([&](double x, double z) {
+      return Vec3{radius * std::sin(x / radius), radius * (1.0 - std::cos(x / radius)), z};
+    });
+    const double chord = 2.0 * radius * std::sin(h / (2.0 * radius)) / h;
+    const double shortened = 3.0 * 2e4 * std::pow(0.5 * (chord * chord - 1.0), 2);
+    const double kappa = 2.0 * (1.0 - std::cos(h / radius)) * radius / (h * h);
+    const double bending = 3.0 * xi * kappa * kappa;
+    EXPECT_NEAR(bent[0], shortened + bending, 1e-6 * bent[0]);
+    const double springs = shortened + (c / radius) * (c / radius) * bending;
+    EXPECT_NEAR(bent[1], springs, 3e-3 * springs);
+  }
 }
 
 // A mass-spring scene of `m` x `n` particles, 1 m apart, 0.1 kg each.

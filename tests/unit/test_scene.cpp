@@ -1023,6 +1023,64 @@ TEST(SceneError, MassSpringModel) {
 #endif
 }
 
+// model.match = "material": the springs come from the Cosserat material the [material] gives
+// (docs/models.md, "Matched springs"), which then holds the mass alone; the options stay the
+// model's own. The grid: 21 x 21 nodes, 10 m square, h = 0.5 m; the material: the reference
+// sheet's 10 kg, ζ = 100, ξ = 0.3, whose bend springs would match its bending at c = 1.22 m with
+// 57.6 ξ c²/h⁴ = 414 N/m and, capped, take half the tension budget 6ζ − ζ₁₂ = 500 N/m: 62.5 N/m.
+TEST(Scene, MassSpringMatchedToTheMaterial) {
+  SceneText text;
+  text.grid = "nodes = [21, 21]\nsize = [10.0, 10.0]\n";
+  text.tail = "[model]\nkind = \"mass-spring\"\nmatch = \"material\"\ndead_zone = 0.001\n";
+  const Scene scene = parse(text);
+  EXPECT_EQ(scene.model_kind, ModelKind::mass_spring);
+  EXPECT_EQ(scene.material.mass, 10.0);
+  EXPECT_EQ(scene.material.xi[0], 0.0);
+  EXPECT_EQ(scene.springs.shear.ke, 100.0);
+  EXPECT_EQ(scene.springs.bend.ke, 62.5);
+  EXPECT_EQ(scene.springs.structural.ke, 250.0);
+  EXPECT_EQ(scene.springs.structural.kd, 0.0);
+  EXPECT_EQ(scene.springs.dead_zone, 0.001);
+  ASSERT_EQ(scene.warnings.size(), 1u);
+  EXPECT_THAT(scene.warnings[0], AllOf(HasSubstr("bend springs store"),
+                                       HasSubstr("\"Matched springs\"")));
+  // A preset is read as for the Cosserat model: its areal density and its ζ, ξ.
+  text.material = "preset = \"silk-10m\"\n";
+  const Scene silk = parse(text);
+  EXPECT_DOUBLE_EQ(silk.material.mass, 78.0);
+  const auto matched = matched_springs(
+      Material{78.0, {100.0, 100.0, 100.0}, {0.01, 0.01, 0.01}, {0.1, 0.1, 0.1}}, 0.78, 0.5);
+  ASSERT_TRUE(matched.has_value());
+  EXPECT_EQ(silk.springs.bend.ke, matched->springs.bend.ke);
+  EXPECT_EQ(silk.springs.structural.ke, matched->springs.structural.ke);
+  EXPECT_EQ(matched->bending_share, 1.0);  // c = 0.199 m on a 0.5 m grid: no cap
+}
+
+TEST(SceneError, MassSpringMatchedToTheMaterial) {
+  SceneText text;
+  text.grid = "nodes = [11, 11]\nsize = [10.0, 10.0]\n";
+  const std::string model = "[model]\nkind = \"mass-spring\"\nmatch = \"material\"\n";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"preset = \"source-sheet\"\n", "give either it or the springs"},
+      {"structural = { ke = 4.0 }\n", "give either it or the springs"},
+      {"bend = { ke = 4.0 }\n", "give either it or the springs"},
+  };
+  for (const auto& [tail, message] : cases) {
+    text.tail = model + tail;
+    EXPECT_THAT(error_of(text), HasSubstr(message)) << tail;
+  }
+  text.tail = "[model]\nkind = \"mass-spring\"\nmatch = \"fabric\"\n";
+  EXPECT_THAT(error_of(text), HasSubstr("unknown match \"fabric\"; allowed: material"));
+  text.tail = model;
+  text.material = "particle_mass = 0.01\n";
+  EXPECT_THAT(error_of(text), HasSubstr("material.particle_mass"));
+  text.material = "mass = 10.0\nzeta = [100.0, 700.0, 100.0]\nxi = 0.3\nphi = 0.0\n";
+  EXPECT_THAT(error_of(text), HasSubstr("leaves the structural springs no stiffness"));
+  text.material = "mass = 10.0\nzeta = 100.0\nxi = 0.3\nphi = 0.001\n";
+  text.grid = "nodes = [11, 21]\nsize = [10.0, 10.0]\n";
+  EXPECT_THAT(error_of(text), HasSubstr("needs square cells"));
+}
+
 // The energy form is the default; the published border rules exist in the flux form alone, so
 // asking for them asks for it, and asking for both the energy form and them is refused.
 TEST(Scene, DiscretisationDefaultsToTheEnergyForm) {

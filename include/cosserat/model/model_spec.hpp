@@ -47,6 +47,22 @@ struct SpringPreset {
 const std::vector<SpringPreset>& spring_presets();
 std::optional<SpringPreset> find_spring_preset(const std::string& name);
 
+// Springs matched to a Cosserat material on square cells of side h (docs/models.md, "Matched
+// springs"): per unit area the spring sheet stores the Cosserat sheet's energy in a small stretch
+// along either axis with the other held, in a small shear, and in a bend of radius c, the
+// bending length under standard gravity, as far as the bend springs may take it without carrying
+// more than half the sheet's stiffness in its plane. The two axes' ζ and ξ are averaged; φ has
+// no counterpart. No damping along the springs: the medium's damping is the models' common one.
+struct MatchedSprings {
+  SpringSpec springs;
+  double bending_length = 0.0;  // c, m; 0 where ξ = 0
+  // The bend springs' stiffness over the one that matches the bend of radius c: 1 unless capped.
+  double bending_share = 1.0;
+};
+// Empty where the in-plane shear resistance ζ₁₂ leaves the structural springs no stiffness
+// (ζ₁₂ ≥ 3 (ζ₁₁ + ζ₂₂)).
+std::optional<MatchedSprings> matched_springs(const Material& material, double density, double h);
+
 // The scene's model keys, its material and its grid's spacings and directions
 // (Scene::model_spec gives it).
 struct ModelSpec {
