@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Hard cases of issue 11 (items 3 and 5) with the three discretisations of the internal force
-# (model.discretisation = "flux", "energy-nodal" and the default "energy", docs/model.md):
+# (model.discretisation = "flux", "energy-nodal" and the default "energy", docs/model.md) and with
+# the mass-spring model, its springs matched to the case's material (model = { kind =
+# "mass-spring", match = "material" }, docs/models.md "Matched springs"):
 # every preset on S2 for 10 s, the 1 m squares of
 # silk, cotton and denim hung from a corner, S6 with its loads x 5, S6 with xi = 0, S4 with the
 # flag preset and the 120 x 120 silk crumple (scenes/hard/). For each run: exit status, the time
@@ -53,9 +55,10 @@ run_one() {  # index label scene steps extra discretisation
   ((QUICK)) && steps=$((steps / 10))
   local every=$((steps / 100 > 0 ? steps / 100 : 1))
   local out=$WORK/$i-$disc
-  local args=(run "$scene" -q -o "$out.h5" --summary "$out.json"
-    --set model.discretisation="\"$disc\"" --set time.steps="$steps"
-    --set time.output_every="$every")
+  local model=(--set model.discretisation="\"$disc\"")
+  [[ $disc == mass-spring ]] && model=(--set 'model={kind="mass-spring", match="material"}')
+  local args=(run "$scene" -q -o "$out.h5" --summary "$out.json" "${model[@]}"
+    --set time.steps="$steps" --set time.output_every="$every")
   [[ -n $extra ]] && args+=(--set "$extra")
   local t0 rc=0
   t0=$(date +%s.%N)
@@ -94,7 +97,7 @@ jobs=$work/jobs
 : >"$jobs"
 for idx in "${!cases[@]}"; do
   IFS='|' read -r label scene steps extra <<<"${cases[$idx]}"
-  for disc in flux energy-nodal energy; do
+  for disc in flux energy-nodal energy mass-spring; do
     printf '%s\0%s\0%s\0%s\0%s\0%s\0' "$idx" "$label" "$scene" "$steps" "$extra" "$disc" >>"$jobs"
   done
 done
@@ -125,12 +128,13 @@ import csv, glob, json, sys
 work, stem, date, cpu, compiler, revision, threads, total, quick, timeout, version = sys.argv[1:]
 rows = sorted((json.load(open(p)) for p in glob.glob(work + "/*.row.json")),
               key=lambda r: (r["index"],
-                             ["flux", "energy-nodal", "energy"].index(r["discretisation"])))
+                             ["flux", "energy-nodal", "energy", "mass-spring"].index(
+                                 r["discretisation"])))
 def g(r, k, fmt):
     q = r.get("quality") or {}
     v = q.get(k, r.get(k))
     return "—" if v is None else format(v, fmt)
-cols = ["case", "discretisation", "exit", "finished", "stopped at t (s)", "dt (s)", "steps",
+cols = ["case", "discretisation or model", "exit", "finished", "stopped at t (s)", "dt (s)", "steps",
         "wall (s)", "min det a/A", "min signed det a/A", "most inverted cells", "min normal cos",
         "most pairs < h/2", "min far distance / h", "area ratio (summary, end)",
         "area ratio min..max (frames)", "message"]
@@ -149,7 +153,7 @@ with open(stem + ".csv", "w", newline="") as f:
     w = csv.writer(f)
     w.writerow(cols)
     w.writerows(table)
-lines = [f"# Hard cases: the flux, nodal energy and energy discretisations, {date}" + (" (QUICK: 1/10 of every run)" if quick == "1" else ""), "",
+lines = [f"# Hard cases: the flux, nodal energy and energy discretisations and matched springs, {date}" + (" (QUICK: 1/10 of every run)" if quick == "1" else ""), "",
          f"Machine: {cpu}; compiler: {compiler}, release; git {revision}; binary `{version}`; "
          f"1 rank x {threads} thread(s), two runs at a time; per-run timeout {timeout} s.",
          f"`benchmarks/run_hard_cases.sh{' --quick' if quick == '1' else ''}`; whole suite {int(total) // 60} min {int(total) % 60} s of wall time. "

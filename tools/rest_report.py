@@ -12,8 +12,8 @@ dual area), with the frames where it rose. Loads, moving solids and free bodies 
 total does not count. The node masses are the discretisation's (docs/model.md, "Energy
 quadrature"): mu0 h1 h2 times the node's share of the dual area (1 inside, 1/2 on a border,
 1/4 at a corner) in the default energy form, mu0 h1 h2 at every node in energy-nodal, M / (m n)
-in flux; mu0 from the scene's material.mass (or density), or for a preset read back from the
-run summary's gravitational energy (--summary).
+in flux and in the mass-spring model; mu0 from the scene's material.mass (or density), or for a
+preset read back from the run summary's gravitational energy (--summary).
 --table prints about 25 frames.
 """
 
@@ -30,8 +30,9 @@ import numpy as np  # noqa: E402
 
 def shares(scene, m, n):
     """Each node's share of the dual area, and the cell count the masses divide M by."""
-    discretisation = scene.get("model", {}).get("discretisation", "energy")
-    if discretisation == "flux":
+    model = scene.get("model", {})
+    discretisation = model.get("discretisation", "energy")
+    if discretisation == "flux" or model.get("kind") == "mass-spring":
         return np.ones((m, n)), m * n
     if discretisation == "energy-nodal":
         return np.ones((m, n)), (m - 1) * (n - 1)
