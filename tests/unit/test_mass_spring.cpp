@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
+#include <vector>
 
 #include "cosserat/model/force_model.hpp"
 #include "cosserat/model/mass_spring.hpp"
@@ -302,6 +304,55 @@ TEST(MassSpring, EnergyConservedToSecondOrder) {
   EXPECT_LT(coarse / fine, 4.5);
 }
 
+
+// Why the return-to-equilibrium sheets stop short (docs/models.md, "Return to equilibrium"):
+// a flat sheet of springs at their rest lengths has no stiffness across itself to first order.
+// Its centre lifted by w stretches its springs by about w²/2ℓ0, so the force that pulls it back
+// goes as w³: eight times as much at 2w. In its plane the same sheet is linear (twice the force
+// at 2w), and pushed in its plane and let go it returns to within 1e-6 m, where pushed across it
+// by the same force for the same time it is still centimetres away after as long. A 7 x 7
+// sheet, border held, 1 m springs and 0.1 kg particles; the push 0.5 N for 0.5 s, then 2.5 s.
+double centre_force(Vec3 lift) {
+  const Scene scene = spring_sheet(7, 7);
+  const Block block = Block::whole(scene.m, scene.n, MPI_COMM_SELF);
+  const auto model = make_force_model(scene.model_spec(), block, 36.0);
+  Field<Vec3> r(block), a(block);
+  for (int l = 0; l < scene.n; ++l)
+    for (int k = 0; k < scene.m; ++k) r(k, l) = {1.0 * k, 0.0, 1.0 * l};
+  r(3, 3) += lift;
+  model->internal_acceleration(r, a);
+  return norm(a(3, 3));
+}
+
+double distance_after_push(Vec3 force) {
+  Scene scene = spring_sheet(7, 7);
+  scene.damping = 1.0;
+  Fix border;
+  std::vector<NodeIndex>& held = border.nodes.nodes;
+  for (int i = 0; i < 7; ++i) held.insert(held.end(), {{i, 0}, {i, 6}});
+  for (int i = 1; i < 6; ++i) held.insert(held.end(), {{0, i}, {6, i}});
+  scene.fixes.push_back(border);
+  Load push;
+  push.nodes.nodes = {{3, 3}};
+  push.force = force;
+  push.window.end_time = 0.5 - 0.5 * scene.dt;
+  scene.loads.push_back(push);
+  Simulation sim(scene, MPI_COMM_SELF);
+  EXPECT_TRUE(testing::advance(sim, 3000));
+  return norm(sim.positions()(3, 3) - Vec3{3.0, 0.0, 3.0});
+}
+
+TEST(MassSpring, AFlatSheetHasNoStiffnessAcrossItself) {
+  const double w = 1e-3;
+  EXPECT_NEAR(centre_force({0.0, 2.0 * w, 0.0}) / centre_force({0.0, w, 0.0}), 8.0, 0.01);
+  EXPECT_NEAR(centre_force({2.0 * w, 0.0, 0.0}) / centre_force({w, 0.0, 0.0}), 2.0, 0.01);
+  const double in_plane = distance_after_push({0.5, 0.0, 0.0});
+  const double across = distance_after_push({0.0, 0.5, 0.0});
+  std::printf("[equilibrium] 3 s after the push: %.3g m pushed in the plane, %.3g m across\n",
+              in_plane, across);
+  EXPECT_LT(in_plane, 1e-6);
+  EXPECT_GT(across, 1e-3);
+}
 
 // The longest and shortest unbroken spring of the run's current state, in rest lengths, and
 // how many springs broke.
