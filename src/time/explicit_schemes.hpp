@@ -60,6 +60,7 @@ class Euler final : public VelocityScheme {
 class Midpoint final : public VelocityScheme {
  public:
   using VelocityScheme::VelocityScheme;
+  bool has_stages() const override { return true; }
   void start(Field<Vec3> velocities) override;
   std::optional<std::string> advance(long step) override;
 
@@ -71,6 +72,7 @@ class Midpoint final : public VelocityScheme {
 class RungeKutta4 final : public VelocityScheme {
  public:
   using VelocityScheme::VelocityScheme;
+  bool has_stages() const override { return true; }
   void start(Field<Vec3> velocities) override;
   std::optional<std::string> advance(long step) override;
 

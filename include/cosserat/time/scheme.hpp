@@ -89,6 +89,10 @@ class Scheme {
   // The proposed velocities, for schemes that carry velocities; the others carry r⁻ instead,
   // so changing next_positions() changes their velocity too.
   virtual Field<Vec3>* next_velocities() { return nullptr; }
+  // Whether a step reads forces at intermediate states (midpoint, rk4), which the actions'
+  // responses never see: a node beside a contact then takes its neighbours inside the solid
+  // for real (Stepper::settle_stage_neighbours).
+  virtual bool has_stages() const { return false; }
 
   // The velocity at the current time (see Stepper::velocities).
   virtual const Field<Vec3>& velocities() = 0;

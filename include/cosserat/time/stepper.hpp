@@ -130,8 +130,10 @@ class Stepper {
 
  private:
   std::optional<Instability> check(const Field<Vec3>& next, double end_time);
+  void settle_stage_neighbours(ProposedStep& proposed);
 
   const Block* block_;
+  Halo* halo_;
   Dynamics* dynamics_;
   Constraints constraints_;
   double dt_;
@@ -146,6 +148,7 @@ class Stepper {
   std::unique_ptr<Scheme> scheme_;
   std::vector<std::unique_ptr<StepAction>> actions_;
   NodeVelocities set_velocities_;  // ProposedStep::velocities
+  Field<Vec3> velocity_set_;       // x: 1 where an action set a node's velocity (stage schemes)
 };
 
 }  // namespace cosserat
