@@ -76,7 +76,6 @@ row = {"label": label, "model": model, "exit": int(rc), "steps": s["steps"],
 with h5py.File(stem + ".h5") as f:
     r, t, v = f["positions"][:], f["time"][:], f["fields/velocity"][:]
     scene = tomllib.loads(f.attrs["scene"])
-    overrides = f.attrs["overrides"]
 if model == "mass-spring":
     scene.setdefault("model", {})["kind"] = "mass-spring"
 frames, m, n, _ = r.shape

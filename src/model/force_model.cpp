@@ -156,11 +156,8 @@ double kernel_bytes_per_node(const ModelSpec& spec) {
   // (docs/model.md, "Damping along the springs"); the flux form its resultants and two
   // tractions; the energy form only row buffers (docs/kernel.md, "Memory"), counted with the
   // threads.
-  if (spec.kind == ModelKind::mass_spring) {
-    const SpringSpec& s = spec.springs;
-    const bool damped = s.structural.kd > 0.0 || s.shear.kd > 0.0 || s.bend.kd > 0.0;
-    return 1.0 + (damped ? 4.0 * sizeof(Vec3) : 0.0);
-  }
+  if (spec.kind == ModelKind::mass_spring)
+    return 1.0 + (spec.springs.damped() ? 4.0 * sizeof(Vec3) : 0.0);
   return is_energy_form(spec.discretisation)
              ? 0.0
              : static_cast<double>(sizeof(NodeResultants) + 2 * sizeof(Vec3));

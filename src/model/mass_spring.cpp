@@ -34,7 +34,6 @@ MassSpring::MassSpring(const ModelSpec& spec, const Block& block)
     incident_[2 * s] = {dk, dl, s, true, rests[s], families[s]};
     incident_[2 * s + 1] = {-dk, -dl, s, false, rests[s], families[s]};
   }
-  damped_ = spec_.structural.kd > 0.0 || spec_.shear.kd > 0.0 || spec_.bend.kd > 0.0;
   breakable_ = std::isfinite(spec_.rupture_length);
   limited_ = spec_.min_length > 0.0 || std::isfinite(spec_.max_length);
   // Gershgorin: a row of M⁻¹D holds Σ kd on its diagonal and as much off it, over the four

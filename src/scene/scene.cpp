@@ -264,15 +264,14 @@ void read_cosserat_material(const Table& material, Scene& scene) {
 // material then is the mass alone, as for any mass-spring scene.
 void match_springs(const Table& material, Scene& scene) {
   read_cosserat_material(material, scene);
-  const double h1 = scene.size1 / (scene.m - 1), h2 = scene.size2 / (scene.n - 1);
+  const double h1 = scene.h1(), h2 = scene.h2();
   if (std::abs(h1 - h2) > 1e-9 * std::max(h1, h2))
     material.fail(fmt::format(
         "model.match = \"material\" needs square cells, got h1 = {:.6g} m and h2 = {:.6g} m: "
         "one spring stiffness per family cannot match both axes",
         h1, h2));
-  const double density = scene.material.mass / (scene.size1 * scene.size2);
   const Material cosserat = scene.material;
-  const auto matched = matched_springs(cosserat, density, h1);
+  const auto matched = matched_springs(cosserat, scene.areal_density(), h1);
   if (!matched)
     material.fail(fmt::format(
         "model.match = \"material\": the shear resistance zeta12 = {} is at least 6 x the "
@@ -621,7 +620,7 @@ void read_time(const Table& time, Scene& scene) {
 #endif
     const SpringSpec& springs = scene.springs;
     if (*integrator == Integrator::semi_implicit && scene.model_kind == ModelKind::mass_spring &&
-        (springs.structural.kd > 0.0 || springs.shear.kd > 0.0 || springs.bend.kd > 0.0)) {
+        springs.damped()) {
       entry->fail(
           "the semi-implicit baseline does not treat the springs' damping kd; use verlet, "
           "which solves for it at the step's centre (docs/model.md, \"Damping along the "

@@ -171,7 +171,7 @@ TEST(DecompositionInvariance, MassSpringFollowsTheOneBlockTrajectory) {
     int broken = 0;
     for (int l = 0; l < scene.n; ++l)
       for (int k = 0; k < scene.m; ++k) broken += bits(k, l) != 0.0 ? 1 : 0;
-      EXPECT_GT(broken, 10);
+    EXPECT_GT(broken, 10);
     Scene unlimited = scene;
     unlimited.springs.min_length = 0.0;
     Simulation free(unlimited, MPI_COMM_SELF);

@@ -28,7 +28,7 @@ class MassSpring final : public ForceModel {
     return 1.0 / node_mass_.interior;
   }
 
-  bool has_velocity_force() const override { return damped_; }
+  bool has_velocity_force() const override { return spec_.damped(); }
   void velocity_acceleration(const Field<Vec3>& r, const Field<Vec3>& v,
                              Field<Vec3>& a) const override;
   double velocity_force_bound() const override { return damping_bound_; }
@@ -87,7 +87,6 @@ class MassSpring final : public ForceModel {
   SpringSpec spec_;
   NodeMass node_mass_;
   double h1h2_;
-  bool damped_;
   bool breakable_;
   bool limited_;
   std::vector<std::int64_t> broken_ids_;  // every block's, ascending

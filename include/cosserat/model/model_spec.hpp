@@ -34,6 +34,8 @@ struct SpringSpec {
   double min_length = 0.0;
   double max_length = std::numeric_limits<double>::infinity();
   double rupture_length = std::numeric_limits<double>::infinity();
+  // Whether any family damps along its springs (the damping solve, docs/model.md).
+  bool damped() const { return structural.kd > 0.0 || shear.kd > 0.0 || bend.kd > 0.0; }
 };
 
 // A named set of springs (docs/model.md, "Spring presets"): the source's experiments, each for
