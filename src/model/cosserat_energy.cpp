@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 #include <vector>
 
+#include "dual.hpp"
 #include "energy_interior.hpp"
 #include "surface_geometry.hpp"
 
@@ -25,6 +27,12 @@ using geometry::Neighbours;
 // Stencil slot of the node (k + dk, l + dl) around p = (k, l).
 constexpr int slot(int dk, int dl) { return 3 * (dl + 1) + (dk + 1); }
 
+// CosseratEnergy::Parts in the scalar the energy is computed in (energy::ScalarOf).
+template <class S>
+struct PartsOf {
+  S node{}, edge1{}, edge2{}, cell{};
+};
+
 // Which terms of E_p exist (docs/equations.md §2.5, "Nodal quadrature"): §2.3 rule 1 leaves the
 // shear terms (ε₁₂, κ₁₂) out on the far borders, rule 2 leaves κ_αα out at nodes lacking an
 // α-neighbour.
@@ -40,34 +48,37 @@ inline Terms terms_of(const Neighbours& p) {
 // triangles, with what its gradient needs: computed once per node for both. Each unit goes
 // through energy::bounded_unit (docs/equations.md, "Crushed cells"); where nothing is crushed
 // the arithmetic is geometry::unit_normal's, so n is the same bits.
-struct CornerNormals {
+template <class V>
+struct BasicCornerNormals {
   struct Corner {
     int ek, el, fk, fl;  // the offsets of the corner's two edges' far nodes
-    Vec3 E, F;           // the edges r_e − r, r_f − r
-    energy::Unit normal;
+    V E, F;              // the edges r_e − r, r_f − r
+    energy::BasicUnit<V> normal;
   };
   Corner corner[4];
   int count = 0;
-  energy::Unit sum;  // n = sum.unit
-  Vec3 n;
+  energy::BasicUnit<V> sum;  // n = sum.unit
+  V n;
 };
 
-CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbours& p,
-                             const energy::InteriorCoefficients& coefficients) {
-  const Vec3 r = R(k, l);
-  CornerNormals c;
+// `at(dk, dl)` is the position of the node (k + dk, l + dl) around p = (k, l).
+template <class V, class At>
+BasicCornerNormals<V> corner_normals(const At& at, const Neighbours& p,
+                                     const energy::InteriorCoefficients& coefficients) {
+  const V r = at(0, 0);
+  BasicCornerNormals<V> c;
   auto add = [&](int ek, int el, int fk, int fl) {
-    CornerNormals::Corner& q = c.corner[c.count++];
+    auto& q = c.corner[c.count++];
     q.ek = ek, q.el = el, q.fk = fk, q.fl = fl;
-    q.E = R(k + ek, l + el) - r;
-    q.F = R(k + fk, l + fl) - r;
+    q.E = at(ek, el) - r;
+    q.F = at(fk, fl) - r;
     q.normal = energy::corner(q.E, q.F, coefficients.corner);
   };
   if (p.right && p.up) add(1, 0, 0, 1);
   if (p.up && p.left) add(0, 1, -1, 0);
   if (p.left && p.down) add(-1, 0, 0, -1);
   if (p.down && p.right) add(0, -1, 1, 0);
-  Vec3 sum;
+  V sum{};
   for (int i = 0; i < c.count; ++i) sum += c.corner[i].normal.unit;
   c.sum = energy::bounded_unit(sum, coefficients.sum);
   c.n = c.sum.unit;
@@ -75,13 +86,13 @@ CornerNormals corner_normals(const Field<Vec3>& R, int k, int l, const Neighbour
 }
 
 // Adds the gradient that flows back through n, given G_n = ∂E/∂n.
-void add_normal_gradient(const CornerNormals& c, const Vec3& G_n,
-                         CosseratEnergy::StencilGradient& g) {
+template <class V>
+void add_normal_gradient(const BasicCornerNormals<V>& c, const V& G_n, std::array<V, 9>& g) {
   // Back through n = s/g(|s|), then through each corner's unit.
-  const Vec3 G_s = energy::unit_gradient(c.sum, G_n);
+  const V G_s = energy::unit_gradient(c.sum, G_n);
   for (int i = 0; i < c.count; ++i) {
-    const CornerNormals::Corner& q = c.corner[i];
-    const energy::CornerGradient d = energy::corner_gradient(q.normal, q.E, q.F, G_s);
+    const auto& q = c.corner[i];
+    const energy::BasicCornerGradient<V> d = energy::corner_gradient(q.normal, q.E, q.F, G_s);
     g[slot(q.ek, q.el)] += d.e;
     g[slot(q.fk, q.fl)] += d.f;
     g[slot(0, 0)] -= d.e + d.f;
@@ -167,33 +178,34 @@ double CosseratEnergy::node_energy(const Field<Vec3>& R, int k, int l, StencilGr
 //   the node, where it has both α-neighbours, weight w_β a (β ≠ α):  Ψ^{αα} κ_αα² +
 //                                      Θ^{αα} ε̄_αα κ_αα, κ_αα = −n · D_αα r, ε̄_αα the mean of
 //                                      the strains of the node's two α-edges.
-double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
-                                          StencilGradient* gradient, Vec3* normal, Parts* parts,
-                                          bool node_terms) const {
+template <class V, class At>
+auto CosseratEnergy::trapezoidal_terms(const At& at, int k, int l, std::array<V, 9>* gradient,
+                                       V* normal, Parts* parts, bool node_terms) const {
+  using S = energy::ScalarOf<V>;
   const Neighbours p = geometry::neighbours(*block_, k, l);
   const double h1 = h1_, h2 = h2_, area = h1 * h2;
   const double wk = p.left && p.right ? 1.0 : 0.5, wl = p.down && p.up ? 1.0 : 0.5;
   const bool bend11 = node_terms && p.left && p.right, bend22 = node_terms && p.down && p.up;
   const bool cell = p.right && p.up;
   const Sym2 &Phi = rest_.Phi, &Psi = rest_.Psi, &Theta = rest_.Theta, &A = rest_.metric;
-  const Vec3 r = R(k, l);
-  if (gradient != nullptr) gradient->fill(Vec3{});
-  StencilGradient* G = gradient;
-  auto add = [&](int dk, int dl, const Vec3& v) { (*G)[slot(dk, dl)] += v; };
-  Parts part;
+  const V r = at(0, 0);
+  if (gradient != nullptr) gradient->fill(V{});
+  std::array<V, 9>* G = gradient;
+  auto add = [&](int dk, int dl, const V& v) { (*G)[slot(dk, dl)] += v; };
+  PartsOf<S> part;
 
   // The edge strains around p: the forward edges' terms are E_p's own, the backward ones only
   // enter the bending terms' ε̄.
-  const Vec3 right = p.right ? R(k + 1, l) - r : Vec3{};
-  const Vec3 left = p.left ? R(k - 1, l) - r : Vec3{};
-  const Vec3 up = p.up ? R(k, l + 1) - r : Vec3{}, down = p.down ? R(k, l - 1) - r : Vec3{};
-  auto strain = [](const Vec3& d, double h, double A_i) {
+  const V right = p.right ? at(1, 0) - r : V{};
+  const V left = p.left ? at(-1, 0) - r : V{};
+  const V up = p.up ? at(0, 1) - r : V{}, down = p.down ? at(0, -1) - r : V{};
+  auto strain = [](const V& d, double h, double A_i) {
     return 0.5 * (dot(d, d) / (h * h) - A_i);
   };
-  const double eps11_f = strain(right, h1, A[0]), eps11_b = strain(left, h1, A[0]);
-  const double eps22_f = strain(up, h2, A[2]), eps22_b = strain(down, h2, A[2]);
+  const S eps11_f = strain(right, h1, A[0]), eps11_b = strain(left, h1, A[0]);
+  const S eps22_f = strain(up, h2, A[2]), eps22_b = strain(down, h2, A[2]);
   // ∂E_p/∂ε of each of the four edge strains, built up term by term.
-  double N11_f = 0.0, N11_b = 0.0, N22_f = 0.0, N22_b = 0.0;
+  S N11_f = 0.0, N11_b = 0.0, N22_f = 0.0, N22_b = 0.0;
   if (p.right) {
     part.edge1 = wl * area * Phi[0] * eps11_f * eps11_f;
     N11_f += 2.0 * wl * area * Phi[0] * eps11_f;
@@ -204,22 +216,22 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
   }
 
   const bool needs_normal = (bend11 || bend22) || normal != nullptr;
-  CornerNormals corners;
-  if (needs_normal) corners = corner_normals(R, k, l, p, interior_);
+  BasicCornerNormals<V> corners;
+  if (needs_normal) corners = corner_normals<V>(at, p, interior_);
   if (normal != nullptr) *normal = corners.n;
-  Vec3 G_n;  // ∂E_p/∂n
-  auto bending = [&](bool exists, const Vec3& d, double h, double w, int i, double eps_f,
-                     double eps_b, double& N_f, double& N_b, int dk, int dl) {
+  V G_n{};  // ∂E_p/∂n
+  auto bending = [&](bool exists, const V& d, double h, double w, int i, const S& eps_f,
+                     const S& eps_b, S& N_f, S& N_b, int dk, int dl) {
     if (!exists) return;
-    const Vec3 n = corners.n;
-    const double kappa = -dot(n, d) / (h * h), eps = 0.5 * (eps_f + eps_b);
+    const V n = corners.n;
+    const S kappa = -dot(n, d) / (h * h), eps = 0.5 * (eps_f + eps_b);
     part.node += w * area * (Psi[i] * kappa * kappa + Theta[i] * eps * kappa);
     if (G == nullptr) return;
-    const double M = w * area * (2.0 * Psi[i] * kappa + Theta[i] * eps);  // ∂E_p/∂κ
+    const S M = w * area * (2.0 * Psi[i] * kappa + Theta[i] * eps);  // ∂E_p/∂κ
     N_f += 0.5 * w * area * Theta[i] * kappa;
     N_b += 0.5 * w * area * Theta[i] * kappa;
     // κ = −n · d/h²: ∂/∂d = −(M/h²) n, ∂/∂n = −(M/h²) d; d = r(p + e) + r(p − e) − 2 r.
-    const Vec3 G_d = (-M / (h * h)) * n;
+    const V G_d = (-M / (h * h)) * n;
     add(dk, dl, G_d);
     add(-dk, -dl, G_d);
     add(0, 0, -2.0 * G_d);
@@ -230,22 +242,22 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
 
   if (cell) {
     // The cell's tangents at its centre, times 2h_α, its normal and X₊₊ before its division.
-    const Vec3 diagonal = R(k + 1, l + 1) - r;
-    const Vec3 t1 = right + (diagonal - up), t2 = up + (diagonal - right);
-    const Vec3 X = (diagonal - right) - up;
-    const double eps12 = 0.5 * (dot(t1, t2) / (4.0 * area) - A[1]);
-    const energy::Unit cell_unit = energy::bounded_unit(cross(t1, t2), interior_.cell);
-    const Vec3 n = cell_unit.unit;
-    const double kappa12 = -dot(n, X) / area;
+    const V diagonal = at(1, 1) - r;
+    const V t1 = right + (diagonal - up), t2 = up + (diagonal - right);
+    const V X = (diagonal - right) - up;
+    const S eps12 = 0.5 * (dot(t1, t2) / (4.0 * area) - A[1]);
+    const auto cell_unit = energy::bounded_unit(cross(t1, t2), interior_.cell);
+    const V n = cell_unit.unit;
+    const S kappa12 = -dot(n, X) / area;
     part.cell = 2.0 * area *
                 (Phi[1] * eps12 * eps12 + Psi[1] * kappa12 * kappa12 + Theta[1] * eps12 * kappa12);
     if (G != nullptr) {
-      const double N12 = 2.0 * area * (2.0 * Phi[1] * eps12 + Theta[1] * kappa12);
-      const double M12 = 2.0 * area * (2.0 * Psi[1] * kappa12 + Theta[1] * eps12);
+      const S N12 = 2.0 * area * (2.0 * Phi[1] * eps12 + Theta[1] * kappa12);
+      const S M12 = 2.0 * area * (2.0 * Psi[1] * kappa12 + Theta[1] * eps12);
       // ε₁₂ = t₁ · t₂/(8a) − ½A₁₂; κ₁₂ = −n · X/a with n = c/g(|c|), c = t₁ × t₂.
-      Vec3 G_t1 = (N12 / (8.0 * area)) * t2, G_t2 = (N12 / (8.0 * area)) * t1;
-      const Vec3 G_X = (-M12 / area) * n, G_cn = (-M12 / area) * X;
-      const Vec3 G_c = energy::unit_gradient(cell_unit, G_cn);
+      V G_t1 = (N12 / (8.0 * area)) * t2, G_t2 = (N12 / (8.0 * area)) * t1;
+      const V G_X = (-M12 / area) * n, G_cn = (-M12 / area) * X;
+      const V G_c = energy::unit_gradient(cell_unit, G_cn);
       G_t1 += cross(t2, G_c);
       G_t2 += cross(G_c, t1);
       // t₁ = r(k+1, l) + r(k+1, l+1) − r − r(k, l+1), t₂ = r(k, l+1) + r(k+1, l+1) − r − r(k+1, l).
@@ -258,8 +270,8 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
 
   if (G != nullptr) {
     // ε = ½ (|d|²/h² − A): ∂/∂d = (N/h²) d, d = r(p ± e) − r.
-    auto edge = [&](double N, const Vec3& d, double h, int dk, int dl) {
-      const Vec3 g = (N / (h * h)) * d;
+    auto edge = [&](const S& N, const V& d, double h, int dk, int dl) {
+      const V g = (N / (h * h)) * d;
       add(dk, dl, g);
       add(0, 0, -1.0 * g);
     };
@@ -269,8 +281,58 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
     if (p.down) edge(N22_b, down, h2, 0, -1);
     if (bend11 || bend22) add_normal_gradient(corners, G_n, *G);
   }
-  if (parts != nullptr) *parts = part;
+  if constexpr (std::is_same_v<S, double>)
+    if (parts != nullptr) *parts = {part.node, part.edge1, part.edge2, part.cell};
   return ((part.node + part.edge1) + part.edge2) + part.cell;
+}
+
+
+double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
+                                          StencilGradient* gradient, Vec3* normal, Parts* parts,
+                                          bool node_terms) const {
+  return trapezoidal_terms(
+      [&R, k, l](int dk, int dl) { return R(k + dk, l + dl); }, k, l, gradient, normal, parts,
+      node_terms);
+}
+
+// The gradient's code run on dual numbers seeded with the 27 coordinates of the box: each
+// gradient entry's derivatives are a row of the Hessian. An interior node reads six of the nine
+// nodes (energy_interior.hpp), so it takes 18 directions instead of 27.
+// flatten: every dual operation inlined into one loop nest per operation, not a call each.
+template <int N>
+[[gnu::flatten]] void CosseratEnergy::stencil_hessian(const Field<Vec3>& R, int k, int l,
+                                     const int (&direction)[9], StencilHessian& H) const {
+  using Dual = energy::Dual<N>;
+  using V = energy::DualVec3<N>;
+  auto at = [&](int dk, int dl) {
+    const int s = slot(dk, dl), first = 3 * direction[s];
+    const Vec3 r = R(k + dk, l + dl);
+    V v{Dual(r.x), Dual(r.y), Dual(r.z)};
+    v.x.d[first] = 1.0, v.y.d[first + 1] = 1.0, v.z.d[first + 2] = 1.0;
+    return v;
+  };
+  std::array<V, 9> G;
+  trapezoidal_terms(at, k, l, &G, static_cast<V*>(nullptr), nullptr, true);
+  H.fill(0.0);
+  for (int a = 0; a < 9; ++a)
+    for (int i = 0; i < 3; ++i) {
+      const Dual& g = i == 0 ? G[a].x : (i == 1 ? G[a].y : G[a].z);
+      for (int b = 0; b < 9; ++b) {
+        if (direction[b] < 0) continue;
+        for (int j = 0; j < 3; ++j) H[(3 * a + i) * 27 + 3 * b + j] = g.d[3 * direction[b] + j];
+      }
+    }
+}
+
+void CosseratEnergy::node_hessian(const Field<Vec3>& R, int k, int l,
+                                  StencilHessian& hessian) const {
+  // Slots in slot() order: (−1,−1) (0,−1) (1,−1) (−1,0) (0,0) (1,0) (−1,1) (0,1) (1,1).
+  static constexpr int kInterior[9] = {-1, 0, -1, 1, 2, 3, -1, 4, 5};
+  static constexpr int kAll[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
+  if (geometry::neighbours(*block_, k, l).interior())
+    stencil_hessian<18>(R, k, l, kInterior, hessian);
+  else
+    stencil_hessian<27>(R, k, l, kAll, hessian);
 }
 
 // E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (docs/equations.md,
@@ -283,7 +345,8 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   const Terms has = terms_of(p);
   const double h1 = h1_, h2 = h2_;
   const Tangents a = tangents(R, k, l, p, h1, h2);
-  const CornerNormals corners = corner_normals(R, k, l, p, interior_);
+  const auto corners =
+      corner_normals<Vec3>([&R, k, l](int dk, int dl) { return R(k + dk, l + dl); }, p, interior_);
   const Vec3 n = corners.n;
   if (normal != nullptr) *normal = n;
   const SecondDerivatives X = second_derivatives(R, k, l, p, h1, h2);

@@ -9,6 +9,7 @@
 // gradient has six nonzero stencil slots; the other three of node_energy's nine are zero.
 
 #include <cmath>
+#include <utility>
 
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/model/cosserat_energy.hpp"
@@ -25,61 +26,77 @@ struct InteriorGradient {
 // y = |c|²/δ², which meets |c| at δ with two matching derivatives and stays ≥ 3δ/8, so u
 // shrinks to zero with the triangle instead of turning at a rate 1/|c| and the stiffness of the
 // terms that read it stays bounded. Above δ the bits are those of c/|c|.
-struct Unit {
-  Vec3 unit;
-  double inverse;  // 1/g
-  double rho;      // g g′(|c|)/|c|: 1 where c is not crushed
+// V is Vec3, or the DualVec3 that differentiates the gradient for the Hessian (dual.hpp).
+template <class V>
+using ScalarOf = decltype(dot(std::declval<V>(), std::declval<V>()));
+
+template <class V>
+struct BasicUnit {
+  V unit;
+  ScalarOf<V> inverse;  // 1/g
+  ScalarOf<V> rho;      // g g′(|c|)/|c|: 1 where c is not crushed
 };
+using Unit = BasicUnit<Vec3>;
 
 // Unbounded, u is c/|c| whether crushed or not, and `crushed` says whether c was: the kernel
 // takes that form for a block of nodes where none is, and there the bits are the same, without
 // the blend's arithmetic and selects (interior_row).
-template <bool Bounded>
-[[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush, long& crushed) {
-  const double length2 = dot(c, c);
-  const double y = length2 * crush.inverse_delta2;
+template <bool Bounded, class V>
+[[gnu::always_inline]] inline BasicUnit<V> bounded_unit(const V& c, const Crush& crush,
+                                                        long& crushed) {
+  using S = ScalarOf<V>;
+  using std::sqrt;
+  const S length2 = dot(c, c);
+  const S y = length2 * crush.inverse_delta2;
   const bool below = y < 1.0;
   if constexpr (!Bounded) {
     crushed |= below ? 1 : 0;
-    const double inverse = 1.0 / std::sqrt(length2);
-    return {c * inverse, inverse, 1.0};
+    const S inverse = 1.0 / sqrt(length2);
+    return {c * inverse, inverse, S(1.0)};
   }
-  const double blend = 0.375 + y * (0.75 - 0.125 * y);
-  const double inverse = 1.0 / (below ? crush.delta * blend : std::sqrt(length2));
-  return {c * inverse, inverse, below ? 0.5 * blend * (3.0 - y) : 1.0};
+  const S blend = 0.375 + y * (0.75 - 0.125 * y);
+  const S inverse = 1.0 / (below ? crush.delta * blend : sqrt(length2));
+  return {c * inverse, inverse, below ? 0.5 * blend * (3.0 - y) : S(1.0)};
 }
 
-[[gnu::always_inline]] inline Unit bounded_unit(const Vec3& c, const Crush& crush) {
+template <class V>
+[[gnu::always_inline]] inline BasicUnit<V> bounded_unit(const V& c, const Crush& crush) {
   long crushed = 0;
   return bounded_unit<true>(c, crush, crushed);
 }
 
 // Back through u = c/g: ∂/∂c of G_u · u.
-[[gnu::always_inline]] inline Vec3 unit_gradient(const Unit& u, const Vec3& G_u) {
+template <class V>
+[[gnu::always_inline]] inline V unit_gradient(const BasicUnit<V>& u, const V& G_u) {
   return (G_u - (u.rho * dot(G_u, u.unit)) * u.unit) * u.inverse;
 }
 
 // One corner triangle of §2.1 rule 2: edges E, F from p and the unit of c = E × F.
-template <bool Bounded>
-[[gnu::always_inline]] inline Unit corner(const Vec3& E, const Vec3& F, const Crush& crush,
-                                          long& crushed) {
+template <bool Bounded, class V>
+[[gnu::always_inline]] inline BasicUnit<V> corner(const V& E, const V& F, const Crush& crush,
+                                                  long& crushed) {
   return bounded_unit<Bounded>(cross(E, F), crush, crushed);
 }
 
-[[gnu::always_inline]] inline Unit corner(const Vec3& E, const Vec3& F, const Crush& crush) {
+template <class V>
+[[gnu::always_inline]] inline BasicUnit<V> corner(const V& E, const V& F, const Crush& crush) {
   long crushed = 0;
   return corner<true>(E, F, crush, crushed);
 }
 
 // Back through a corner's unit and c = E × F: ∂/∂r of G_s · u at its edges' far nodes; at p it
 // is minus their sum.
-struct CornerGradient {
-  Vec3 e, f;
+template <class V>
+struct BasicCornerGradient {
+  V e, f;
 };
+using CornerGradient = BasicCornerGradient<Vec3>;
 
-[[gnu::always_inline]] inline CornerGradient corner_gradient(const Unit& q, const Vec3& E,
-                                                             const Vec3& F, const Vec3& G_s) {
-  const Vec3 G_c = unit_gradient(q, G_s);
+template <class V>
+[[gnu::always_inline]] inline BasicCornerGradient<V> corner_gradient(const BasicUnit<V>& q,
+                                                                     const V& E, const V& F,
+                                                                     const V& G_s) {
+  const V G_c = unit_gradient(q, G_s);
   // G_c · (δE × F) = δE · (F × G_c), G_c · (E × δF) = δF · (G_c × E).
   return {cross(F, G_c), cross(G_c, E)};
 }

@@ -394,6 +394,62 @@ TEST(EnergyForm, JacobianIsSymmetric) {
   }
 }
 
+// node_hessian, summed over the nodes, is the Hessian of E: exactly symmetric, and the derivative
+// of −force by central differences to their truncation error, on the deformed sheet with every
+// term and on the same sheet with a corner crushed to a hundredth of a spacing (the blend of
+// docs/equations.md, "Crushed cells"). A sign or a slot wrong in the differentiation shows as
+// an O(1) relative difference.
+TEST(EnergyForm, NodeHessiansAreTheDerivativeOfTheForce) {
+  for (const bool crush : {false, true}) {
+    SCOPED_TRACE(crush ? "a crushed corner" : "deformed");
+    Sheet sheet(coupled_sheet());
+    const Scene& s = sheet.scene;
+    if (crush) {
+      const Vec3 mid = 0.5 * (sheet.r(4, 3) + sheet.r(3, 4)), across = sheet.r(3, 3) - mid;
+      sheet.r(3, 3) = mid + (1e-2 * s.h1() / norm(across)) * across;
+    }
+    const int m = s.m, n = s.n, size = 3 * m * n;
+    std::vector<double> H(static_cast<std::size_t>(size) * size, 0.0);
+    CosseratEnergy::StencilHessian h;
+    for (int l = 0; l < n; ++l)
+      for (int k = 0; k < m; ++k) {
+        sheet.energy.node_hessian(sheet.r, k, l, h);
+        for (int a = 0; a < 9; ++a)
+          for (int b = 0; b < 9; ++b) {
+            const int ak = k + a % 3 - 1, al = l + a / 3 - 1, bk = k + b % 3 - 1, bl = l + b / 3 - 1;
+            if (ak < 0 || ak >= m || al < 0 || al >= n || bk < 0 || bk >= m || bl < 0 || bl >= n)
+              continue;
+            for (int i = 0; i < 3; ++i)
+              for (int j = 0; j < 3; ++j)
+                H[static_cast<std::size_t>(3 * (al * m + ak) + i) * size + 3 * (bl * m + bk) + j] +=
+                    h[static_cast<std::size_t>((3 * a + i) * 27 + 3 * b + j)];
+          }
+      }
+    Field<Vec3> up(sheet.block), down(sheet.block);
+    const double step = crush ? 1e-7 : 1e-6;
+    double largest = 0.0, worst = 0.0, asymmetry = 0.0;
+    for (int column = 0; column < size; ++column) {
+      const int node = column / 3, c = column % 3;
+      forces_either_side(sheet, node % m, node / m, c, step, up, down);
+      for (int row = 0; row < size; ++row) {
+        const int rn = row / 3, rc = row % 3;
+        const double difference =
+            -(up(rn % m, rn / m)[rc] - down(rn % m, rn / m)[rc]) / (2.0 * step);
+        const double exact = H[static_cast<std::size_t>(row) * size + column];
+        largest = std::max(largest, std::abs(exact));
+        worst = std::max(worst, std::abs(exact - difference));
+        asymmetry =
+            std::max(asymmetry, std::abs(exact - H[static_cast<std::size_t>(column) * size + row]));
+      }
+    }
+    std::printf("[hessian] %s: largest entry %.3e, off the differences by %.2e, asymmetry %.2e\n",
+                crush ? "crushed" : "deformed", largest, worst, asymmetry);
+    ASSERT_GT(largest, 1.0);
+    EXPECT_LT(worst, 1e-6 * largest);
+    EXPECT_LT(asymmetry, 1e-13 * largest);
+  }
+}
+
 // docs/equations.md §5 item 1 for the energy form: a rotated and translated rest sheet stores no
 // energy and feels no force.
 TEST(EnergyForm, RigidMotionHasNoEnergyAndNoForce) {

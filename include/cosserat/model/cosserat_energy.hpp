@@ -119,6 +119,14 @@ class CosseratEnergy {
   double node_energy(const Field<Vec3>& positions, int k, int l, StencilGradient* gradient,
                      Vec3* normal = nullptr, Parts* parts = nullptr) const;
 
+  // ∂²E_p/∂r_a∂r_b for the nodes a, b of p's 3 × 3 box (slots as node_energy's): the entry
+  // for component i of slot a and j of slot b is at (3a + i) · 27 + 3b + j, and a slot outside
+  // the grid has zero rows and columns. The exact derivative of node_energy's gradient, by
+  // forward-mode differentiation of the same code (docs/semi-implicit.md, "The Jacobian");
+  // trapezoidal quadrature only.
+  using StencilHessian = std::array<double, 27 * 27>;
+  void node_hessian(const Field<Vec3>& positions, int k, int l, StencilHessian& hessian) const;
+
   // The threads' bands of owned rows, which follow the threads' speeds. Public for the tests that
   // hold the forces to the same bits on every split.
   RowBalance& row_balance() { return balance_; }
@@ -168,6 +176,15 @@ class CosseratEnergy {
   double trapezoidal_energy(const Field<Vec3>& positions, int k, int l,
                             StencilGradient* gradient, Vec3* normal, Parts* parts,
                             bool node_terms = true) const;
+  // trapezoidal_energy for positions `at(dk, dl)` around (k, l) of type V: Vec3, or the dual
+  // numbers of node_hessian. Defined and instantiated in cosserat_energy.cpp.
+  template <class V, class At>
+  auto trapezoidal_terms(const At& at, int k, int l, std::array<V, 9>* gradient, V* normal,
+                         Parts* parts, bool node_terms) const;
+  // node_hessian with N directions; direction[s] is the seed of slot s (−1: not read).
+  template <int N>
+  void stencil_hessian(const Field<Vec3>& positions, int k, int l, const int (&direction)[9],
+                       StencilHessian& hessian) const;
 
   const Block* block_;
   double h1_, h2_;
