@@ -30,6 +30,10 @@ void ForceModel::restore_step_state(const std::vector<double>& state) {
     throw std::invalid_argument("the checkpoint holds a model state this model does not have");
 }
 
+void ForceModel::node_hessian(const Field<Vec3>&, int, int, std::array<double, 27 * 27>&) const {
+  throw std::logic_error("ForceModel::node_hessian: this model has no node Hessian");
+}
+
 void ForceModel::broken_springs(Field<double>& bits) const {
   const Block& b = bits.block();
   for (int l = b.l0; l < b.l1; ++l)
@@ -87,6 +91,12 @@ class EnergyForm final : public CosseratForm {
   void free_acceleration_rows(const Field<Vec3>& r, const Vec3& gravity,
                               const RowConsumer& consume) override {
     energy_.internal_force_rows(r, 1.0 / node_mass_.interior, gravity, consume);
+  }  bool has_node_hessian() const override {
+    return energy_.quadrature() == Quadrature::trapezoidal;
+  }
+  void node_hessian(const Field<Vec3>& r, int k, int l,
+                    std::array<double, 27 * 27>& hessian) const override {
+    energy_.node_hessian(r, k, l, hessian);
   }
 };
 
