@@ -1,12 +1,14 @@
 // The semi-implicit baseline on PETSc: a DMDA over the solver's own
-// decomposition, the Jacobian of the internal acceleration by MatFDColoring,
-// KSP for the step's linear system.
+// decomposition, the Jacobian of the internal acceleration assembled from the model's exact
+// node Hessians (or by MatFDColoring for a model without them), KSP for the step's linear
+// system (docs/semi-implicit.md).
 
 #include <fmt/format.h>
 #include <petscdmda.h>
 #include <petscksp.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <source_location>
 #include <stdexcept>
@@ -68,17 +70,29 @@ struct SemiImplicitSolver::Impl {
   PetscInt offset(int k, int l, int c) const {
     return (static_cast<PetscInt>(l - block->l0) * block->owned_k() + (k - block->k0)) * 3 + c;
   }
+  void set_up_colouring(const Scene& scene);
   void copy_in(const Field<Vec3>& field, Vec v) const;
   void copy_out(Vec v, Field<Vec3>& field) const;
+  // −Σ_p ∂²E_p/∂r∂r over the interior mass into the owned rows of `jacobian`.
+  void assemble_hessians(const Field<Vec3>& r);
 
   const Block* block;
   Dynamics* dynamics;
   double dt;
+  // The exact Jacobian from node Hessians: the system is then solved times the node weights
+  // w (masses over the interior mass), which makes it symmetric (docs/semi-implicit.md).
+  bool exact;
+  bool second_order;  // semi-implicit-2: ½ J, and −½ J d on the right-hand side
   DM da = nullptr;
-  Mat matrix = nullptr;
+  Mat jacobian = nullptr;  // W J, kept across the steps that reuse it
+  Mat system = nullptr;    // the step's matrix, built from it each step
+  long jacobian_every;     // rebuild J on the steps that are multiples of it
+  bool built = false;      // J exists
+  bool fresh = false;      // J was rebuilt for this step
   MatFDColoring colouring = nullptr;
   KSP ksp = nullptr;
   Vec x = nullptr, local = nullptr, b = nullptr, delta = nullptr;
+  Vec weights = nullptr, shift = nullptr;  // w at each unknown; the diagonal's share, c w
   PetscInt first_row = 0;
   Field<Vec3> r_view, a_view;
   LinearSolveStats stats;
@@ -86,7 +100,14 @@ struct SemiImplicitSolver::Impl {
 
 SemiImplicitSolver::Impl::Impl(const Scene& scene, const Decomposition& decomposition,
                                const Block& block_, Dynamics& dynamics_)
-    : block(&block_), dynamics(&dynamics_), dt(scene.dt), r_view(block_), a_view(block_) {
+    : block(&block_),
+      dynamics(&dynamics_),
+      dt(scene.dt),
+      exact(dynamics_.model().has_node_hessian()),
+      second_order(scene.integrator == Integrator::semi_implicit_2),
+      jacobian_every(scene.solver.jacobian_every),
+      r_view(block_),
+      a_view(block_) {
   start_petsc();
   const Block& bl = *block;
   std::vector<PetscInt> widths_k, widths_l;
@@ -106,33 +127,32 @@ SemiImplicitSolver::Impl::Impl(const Scene& scene, const Decomposition& decompos
   }
 
   check(DMSetMatType(da, MATAIJ));
-  check(DMCreateMatrix(da, &matrix));
+  check(DMCreateMatrix(da, &jacobian));
+  check(MatDuplicate(jacobian, MAT_DO_NOT_COPY_VALUES, &system));
+  // Its held rows and columns are zeroed each step; its pattern must stay J's for the next
+  // step's copy.
+  check(MatSetOption(system, MAT_KEEP_NONZERO_PATTERN, PETSC_TRUE));
   check(DMCreateGlobalVector(da, &x));
   check(VecDuplicate(x, &b));
   check(VecDuplicate(x, &delta));
   check(DMCreateLocalVector(da, &local));
   check(VecGetOwnershipRange(x, &first_row, nullptr));
-
-  ISColoring colours;
-  check(DMCreateColoring(da, IS_COLORING_GLOBAL, &colours));
-  check(MatFDColoringCreate(matrix, colours, &colouring));
-  // PETSc takes the function type-erased; void(*)(void) is the cast GCC accepts
-  // as generic.
-  check(
-      MatFDColoringSetFunction(colouring,
-                               reinterpret_cast<PetscErrorCode (*)(void)>(
-                                   reinterpret_cast<void (*)(void)>(&Impl::internal_acceleration)),
-                               this));
-  // A position's perturbation is sqrt(eps) times its size, but at least
-  // sqrt(eps) times a grid spacing: PETSc's floor (1e-6) would perturb a node
-  // near the origin by 1e-14 m and lose the difference in round-off.
-  check(MatFDColoringSetParameters(colouring, PETSC_DEFAULT, std::min(scene.h1(), scene.h2())));
-  check(MatFDColoringSetFromOptions(colouring));
-  check(MatFDColoringSetUp(matrix, colours, colouring));
-  check(ISColoringDestroy(&colours));
+  check(VecDuplicate(x, &weights));
+  check(VecDuplicate(x, &shift));
+  {
+    Field<Vec3> w(bl);
+    const NodeMass& mass = dynamics->model().node_mass();
+    for (int l = bl.l0; l < bl.l1; ++l)
+      for (int k = bl.k0; k < bl.k1; ++k) {
+        const double weight = exact ? mass.weight(k, l) : 1.0;
+        w(k, l) = Vec3{weight, weight, weight};
+      }
+    copy_in(w, weights);
+  }
+  if (!exact) set_up_colouring(scene);
 
   check(KSPCreate(bl.comm, &ksp));
-  check(KSPSetOperators(ksp, matrix, matrix));
+  check(KSPSetOperators(ksp, system, system));
   const LinearSolver& linear = scene.solver;
   set_or_refuse([&] { return KSPSetType(ksp, linear.ksp.c_str()); },
                 fmt::format("{}: time.solver.ksp: PETSc has no Krylov method \"{}\" (for example "
@@ -153,11 +173,36 @@ SemiImplicitSolver::Impl::Impl(const Scene& scene, const Decomposition& decompos
                 "preconditioner PETSc does not have; see the message above");
 }
 
+// The finite-difference Jacobian, for a model without node Hessians: PETSc differences the
+// internal acceleration over a colouring of the DMDA's box stencil.
+void SemiImplicitSolver::Impl::set_up_colouring(const Scene& scene) {
+  ISColoring colours;
+  check(DMCreateColoring(da, IS_COLORING_GLOBAL, &colours));
+  check(MatFDColoringCreate(jacobian, colours, &colouring));
+  // PETSc takes the function type-erased; void(*)(void) is the cast GCC accepts
+  // as generic.
+  check(
+      MatFDColoringSetFunction(colouring,
+                               reinterpret_cast<PetscErrorCode (*)(void)>(
+                                   reinterpret_cast<void (*)(void)>(&Impl::internal_acceleration)),
+                               this));
+  // A position's perturbation is sqrt(eps) times its size, but at least
+  // sqrt(eps) times a grid spacing: PETSc's floor (1e-6) would perturb a node
+  // near the origin by 1e-14 m and lose the difference in round-off.
+  check(MatFDColoringSetParameters(colouring, PETSC_DEFAULT, std::min(scene.h1(), scene.h2())));
+  check(MatFDColoringSetFromOptions(colouring));
+  check(MatFDColoringSetUp(jacobian, colours, colouring));
+  check(ISColoringDestroy(&colours));
+}
+
 SemiImplicitSolver::Impl::~Impl() {
   // Destruction must not throw; PETSc reports its own errors.
   KSPDestroy(&ksp);
   MatFDColoringDestroy(&colouring);
-  MatDestroy(&matrix);
+  MatDestroy(&system);
+  MatDestroy(&jacobian);
+  VecDestroy(&shift);
+  VecDestroy(&weights);
   VecDestroy(&delta);
   VecDestroy(&b);
   VecDestroy(&local);
@@ -218,15 +263,83 @@ SemiImplicitSolver::SemiImplicitSolver(const Scene& scene, const Decomposition& 
 
 SemiImplicitSolver::~SemiImplicitSolver() = default;
 
+// Each node p's Hessian adds into the rows of the owned nodes of its box, so a block takes the
+// p of its owned nodes and of the ring around them (their E_p read two nodes out: the ghosts).
+// An interior p's energy reads six nodes of its box (CosseratEnergy::node_hessian), a border
+// node's any of the nine.
+void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
+  const Block& bl = *block;
+  const ForceModel& model = dynamics->model();
+  const double scale = -1.0 / model.node_mass().interior;
+  constexpr int kRead[6] = {1, 3, 4, 5, 7, 8};  // slots 3 (dl + 1) + (dk + 1) of (0,−1) … (1,1)
+  std::array<double, 27 * 27> h;
+  std::vector<PetscScalar> values;
+  check(MatZeroEntries(jacobian));
+  for (int l = std::max(bl.l0 - 1, 0); l < std::min(bl.l1 + 1, bl.n); ++l)
+    for (int k = std::max(bl.k0 - 1, 0); k < std::min(bl.k1 + 1, bl.m); ++k) {
+      model.node_hessian(r, k, l, h);
+      const bool interior = k > 0 && k < bl.m - 1 && l > 0 && l < bl.n - 1;
+      int slots[9], count = 0;
+      if (interior)
+        for (const int a : kRead) slots[count++] = a;
+      else
+        for (int a = 0; a < 9; ++a) {
+          const int qk = k + a % 3 - 1, ql = l + a / 3 - 1;
+          if (qk >= 0 && qk < bl.m && ql >= 0 && ql < bl.n) slots[count++] = a;
+        }
+      MatStencil rows[9], columns[9];
+      int row_slots[9], row_count = 0;
+      for (int i = 0; i < count; ++i) {
+        const int a = slots[i], qk = k + a % 3 - 1, ql = l + a / 3 - 1;
+        columns[i] = MatStencil{0, ql, qk, 0};
+        if (bl.owns(qk, ql)) {
+          rows[row_count] = columns[i];
+          row_slots[row_count++] = a;
+        }
+      }
+      if (row_count == 0) continue;
+      values.resize(static_cast<std::size_t>(9 * row_count * count));
+      std::size_t v = 0;
+      for (int ri = 0; ri < row_count; ++ri)
+        for (int i = 0; i < 3; ++i)
+          for (int ci = 0; ci < count; ++ci)
+            for (int j = 0; j < 3; ++j)
+              values[v++] = scale * h[static_cast<std::size_t>((3 * row_slots[ri] + i) * 27 +
+                                                                3 * slots[ci] + j)];
+      check(MatSetValuesBlockedStencil(jacobian, row_count, rows, count, columns, values.data(),
+                                       ADD_VALUES));
+    }
+  check(MatAssemblyBegin(jacobian, MAT_FINAL_ASSEMBLY));
+  check(MatAssemblyEnd(jacobian, MAT_FINAL_ASSEMBLY));
+}
+
 void SemiImplicitSolver::linearise(const Field<Vec3>& r) {
   Impl& s = *impl_;
   const auto start = std::chrono::steady_clock::now();
-  s.copy_in(r, s.x);
-  // The colouring writes only the entries it computes; start from a clean
-  // matrix.
-  check(MatZeroEntries(s.matrix));
-  check(MatFDColoringApply(s.matrix, s.colouring, s.x, nullptr));
+  if (s.exact) {
+    s.assemble_hessians(r);
+    // The rigid motions at rⁿ are what the elastic part leaves free: algebraic multigrid
+    // (gamg) builds its coarse spaces from them.
+    s.copy_in(r, s.x);
+    MatNullSpace rigid;
+    check(MatNullSpaceCreateRigidBody(s.x, &rigid));
+    check(MatSetNearNullSpace(s.system, rigid));
+    check(MatNullSpaceDestroy(&rigid));
+  } else {
+    s.copy_in(r, s.x);
+    // The colouring writes only the entries it computes; start from a clean matrix.
+    check(MatZeroEntries(s.jacobian));
+    check(MatFDColoringApply(s.jacobian, s.colouring, s.x, nullptr));
+  }
+  s.built = true;
+  s.fresh = true;
+  s.stats.jacobians += 1;
   s.stats.jacobian_seconds += seconds_since(start);
+}
+
+bool SemiImplicitSolver::needs_jacobian(long step) const {
+  const Impl& s = *impl_;
+  return !s.built || step % s.jacobian_every == 0;
 }
 
 std::optional<std::string> SemiImplicitSolver::solve(
@@ -239,14 +352,27 @@ std::optional<std::string> SemiImplicitSolver::solve(
   const double dt = s.dt;
   const double diagonal = 1.0 / (dt * dt) + terms.damping / (2.0 * dt);
 
-  // [(1/Δt² + D/(2Δt)) I + F/(2Δt) n nᵀ − J]: the centred velocity terms of
-  // docs/equations.md §4.
-  check(MatScale(s.matrix, -1.0));
-  check(MatShift(s.matrix, diagonal));
+  s.copy_in(rhs, s.b);
+  check(VecPointwiseMult(s.b, s.b, s.weights));
+  s.copy_in(guess, s.delta);
+  if (s.second_order) {
+    // −½ W J d: the force at the mean of rⁿ⁺¹ and rⁿ⁻¹ (docs/semi-implicit.md).
+    check(MatMult(s.jacobian, s.delta, s.x));
+    check(VecAXPY(s.b, -0.5, s.x));
+  }
+  // W [(1/Δt² + D/(2Δt)) I + F/(2Δt) n nᵀ] − W J (½ W J in the second-order step): the
+  // centred velocity terms of docs/equations.md §4, each row times its node's weight (1 with a
+  // differenced J).
+  check(MatCopy(s.jacobian, s.system, SAME_NONZERO_PATTERN));
+  check(MatScale(s.system, s.second_order ? -0.5 : -1.0));
+  check(VecCopy(s.weights, s.shift));
+  check(VecScale(s.shift, diagonal));
+  check(MatDiagonalSet(s.system, s.shift, ADD_VALUES));
   if (terms.fluid > 0.0) {
-    const double weight = terms.fluid / (2.0 * dt);
+    const NodeMass& mass = s.dynamics->model().node_mass();
     for (int l = bl.l0; l < bl.l1; ++l)
       for (int k = bl.k0; k < bl.k1; ++k) {
+        const double weight = terms.fluid / (2.0 * dt) * (s.exact ? mass.weight(k, l) : 1.0);
         const Vec3 n = (*normals)(k, l);
         MatStencil node[3];
         PetscScalar block[9];
@@ -254,18 +380,16 @@ std::optional<std::string> SemiImplicitSolver::solve(
           node[a] = MatStencil{0, l, k, a};
           for (int c = 0; c < 3; ++c) block[3 * a + c] = weight * n[a] * n[c];
         }
-        check(MatSetValuesStencil(s.matrix, 3, node, 3, node, block, ADD_VALUES));
+        check(MatSetValuesStencil(s.system, 3, node, 3, node, block, ADD_VALUES));
       }
-    check(MatAssemblyBegin(s.matrix, MAT_FINAL_ASSEMBLY));
-    check(MatAssemblyEnd(s.matrix, MAT_FINAL_ASSEMBLY));
+    check(MatAssemblyBegin(s.system, MAT_FINAL_ASSEMBLY));
+    check(MatAssemblyEnd(s.system, MAT_FINAL_ASSEMBLY));
   }
 
   // Held components: δ is the held value at the step's end less rⁿ (0 for a still fix), rows
   // and columns replaced by the diagonal (symmetry kept for cg), the other rows' right-hand
   // side moved by the columns' share of that δ.
   std::vector<PetscInt> held_rows;
-  s.copy_in(rhs, s.b);
-  s.copy_in(guess, s.delta);
   for (const Constraints::NodeState& node : held)
     if (bl.owns(node.k, node.l))
       for (int c = 0; c < 3; ++c)
@@ -279,9 +403,15 @@ std::optional<std::string> SemiImplicitSolver::solve(
   check(VecAssemblyEnd(s.b));
   check(VecAssemblyBegin(s.delta));
   check(VecAssemblyEnd(s.delta));
-  check(MatZeroRowsColumns(s.matrix, static_cast<PetscInt>(held_rows.size()), held_rows.data(),
+  check(MatZeroRowsColumns(s.system, static_cast<PetscInt>(held_rows.size()), held_rows.data(),
                            diagonal, s.delta, s.b));
 
+  const auto setup_start = std::chrono::steady_clock::now();
+  // A step that reuses J keeps the preconditioner built with it.
+  check(KSPSetReusePreconditioner(s.ksp, s.fresh ? PETSC_FALSE : PETSC_TRUE));
+  s.fresh = false;
+  check(KSPSetUp(s.ksp));
+  s.stats.setup_seconds += seconds_since(setup_start);
   check(KSPSolve(s.ksp, s.b, s.delta));
   KSPConvergedReason reason;
   PetscInt iterations;

@@ -31,11 +31,13 @@ class SemiImplicitScheme final : public VerletFamily {
 
 // The linearly implicit central-difference step: f_int(rⁿ⁺¹) ≈ f_int(rⁿ) + J δ, per unit mass
 //   [(1/Δt² + D/(2Δt)) I + F/(2Δt) n nᵀ − J] δ = a(rⁿ) + (1/Δt² − D/(2Δt)) d − F/(2Δt) (n·d) n
-// With J = 0 it is the centred Verlet step's closed form.
+// With J = 0 it is the centred Verlet step's closed form. semi-implicit-2 takes the force at
+// the mean of rⁿ⁺¹ and rⁿ⁻¹ instead, f_int(rⁿ) + ½ J (δ − d): ½ J in the matrix, −½ J d on the
+// right (the solver adds both).
 std::optional<std::string> SemiImplicitScheme::propose(long step) {
   Constraints& constraints = context_.constraints;
   constraints.hold_positions(previous_positions_, previous_time(dt_previous_));
-  solver_.linearise(positions_);
+  if (solver_.needs_jacobian(step)) solver_.linearise(positions_);
   Field<Vec3>* n_field = normals();
   const VelocityTerms terms =
       context_.dynamics.free_acceleration(positions_, step, acceleration_, n_field);
@@ -65,7 +67,7 @@ std::optional<std::string> SemiImplicitScheme::propose(long step) {
 }  // namespace
 
 std::unique_ptr<Scheme> any_scheme(const SchemeSetup& setup) {
-  if (setup.scene.integrator == Integrator::semi_implicit)
+  if (is_semi_implicit(setup.scene.integrator))
     return std::make_unique<SemiImplicitScheme>(setup);
   return explicit_scheme(setup);
 }

@@ -27,9 +27,14 @@ class SemiImplicitSolver {
   SemiImplicitSolver(const SemiImplicitSolver&) = delete;
   SemiImplicitSolver& operator=(const SemiImplicitSolver&) = delete;
 
-  // J at r (owned nodes; the DMDA fills its own ghosts). Evaluates the internal
-  // force about 76 times.
+  // J at r: from the model's node Hessians (reads r's ghosts two nodes out), or, for a model
+  // without them, by finite differences (the DMDA fills its own ghosts; 76 evaluations of the
+  // internal force).
   void linearise(const Field<Vec3>& r);
+  // Whether step `step` takes a new J: the first step of a run or of a restart, and every
+  // step that is a multiple of time.solver.jacobian_every; the others reuse the last J and
+  // its preconditioner.
+  bool needs_jacobian(long step) const;
 
   // Solves the system for δ with the J of the last linearise(), velocity terms
   // `terms` (and the normals at rⁿ when there is a fluid), right-hand side `rhs`, starting

@@ -103,10 +103,11 @@ std::string to_json(const RunSummary& s) {
   if (const auto& l = s.linear_solves) {
     linear_solves = fmt::format(
         R"({{"solves": {}, "iterations": {}, "mean_iterations": {}, "most_iterations": {}, )"
-        R"("jacobian_seconds": {}, "solve_seconds": {}}})",
+        R"("jacobian_seconds": {}, "jacobians": {}, "solve_seconds": {}, "setup_seconds": {}}})",
         l->solves, l->iterations,
         json_number(l->solves > 0 ? static_cast<double>(l->iterations) / l->solves : 0.0),
-        l->most_iterations, json_number(l->jacobian_seconds), json_number(l->solve_seconds));
+        l->most_iterations, json_number(l->jacobian_seconds), l->jacobians,
+        json_number(l->solve_seconds), json_number(l->setup_seconds));
   }
   std::string rest = "null";
   if (const auto& r = s.rest) {

@@ -472,7 +472,7 @@ void read_environment(const Table& environment, Scene& scene) {
 }
 
 LinearSolver read_solver(const Table& solver) {
-  solver.allow({"ksp", "pc", "rtol", "atol", "max_iterations"});
+  solver.allow({"ksp", "pc", "rtol", "atol", "max_iterations", "jacobian_every"});
   LinearSolver linear;
   // The names are PETSc's (gmres, cg, bcgs, ...; bjacobi, jacobi, gamg, none, ...); PETSc checks
   // them when the solver is set up, before the first step.
@@ -482,6 +482,9 @@ LinearSolver read_solver(const Table& solver) {
   if (const auto atol = solver.find("atol")) linear.atol = positive(*atol);
   if (const auto iterations = solver.find("max_iterations")) {
     linear.max_iterations = integer_at_least(*iterations, 1);
+  }
+  if (const auto every = solver.find("jacobian_every")) {
+    linear.jacobian_every = integer_at_least(*every, 1);
   }
   return linear;
 }
@@ -534,7 +537,8 @@ void read_adaptive_step(const Table& time, const std::optional<Table>& dt, Scene
   switch (scene.integrator) {
     case Integrator::leapfrog:
     case Integrator::verlet_lagged:
-    case Integrator::semi_implicit: {
+    case Integrator::semi_implicit:
+    case Integrator::semi_implicit_2: {
       const std::string why = fmt::format(
           "the {} integrator assumes a constant step; variable steps (adaptive or random) work "
           "with verlet, tc-verlet, symplectic-euler, euler, midpoint, rk4 and velocity-verlet",
@@ -612,14 +616,14 @@ void read_time(const Table& time, Scene& scene) {
           fmt::format("unknown integrator \"{}\"; allowed: {}", name, joined(integrator_names())));
     }
 #ifndef COSSERAT_HAVE_PETSC
-    if (*integrator == Integrator::semi_implicit) {
+    if (is_semi_implicit(*integrator)) {
       entry->fail(
-          "the semi-implicit integrator is the PETSc baseline, and this build has no PETSc "
+          "the semi-implicit integrators are the PETSc baseline, and this build has no PETSc "
           "(install libpetsc-real-dev and configure with -DCOSSERAT_WITH_PETSC=ON)");
     }
 #endif
     const SpringSpec& springs = scene.springs;
-    if (*integrator == Integrator::semi_implicit && scene.model_kind == ModelKind::mass_spring &&
+    if (is_semi_implicit(*integrator) && scene.model_kind == ModelKind::mass_spring &&
         springs.damped()) {
       entry->fail(
           "the semi-implicit baseline does not treat the springs' damping kd; use verlet, "
@@ -631,7 +635,7 @@ void read_time(const Table& time, Scene& scene) {
   if (const auto solver = time.find_table("solver")) {
     scene.solver = read_solver(*solver);
     // A sweep over integrators keeps the table; only the semi-implicit one reads it.
-    if (scene.integrator != Integrator::semi_implicit) {
+    if (!is_semi_implicit(scene.integrator)) {
       scene.warnings.push_back(
           "[time.solver] is read by the semi-implicit integrator only; ignored for " +
           integrator_name(scene.integrator));

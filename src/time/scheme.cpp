@@ -55,7 +55,8 @@ std::unique_ptr<Scheme> explicit_scheme(const SchemeSetup& setup) {
     case Integrator::midpoint: return std::make_unique<Midpoint>(c, r);
     case Integrator::rk4: return std::make_unique<RungeKutta4>(c, r);
     case Integrator::velocity_verlet: return std::make_unique<VelocityVerlet>(c, r);
-    case Integrator::semi_implicit: break;
+    case Integrator::semi_implicit:
+    case Integrator::semi_implicit_2: break;
   }
   throw std::logic_error(
       "the semi-implicit scheme is built by the baseline module (cosserat::any_scheme)");

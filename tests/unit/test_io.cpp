@@ -775,10 +775,10 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
 // The semi-implicit integrator's solves and --until-rest's result, as objects.
 TEST(RunSummaryTest, WritesLinearSolvesAndRest) {
   RunSummary summary = example_summary();
-  summary.linear_solves = LinearSolveStats{10, 25, 4, 0.5, 0.25};
+  summary.linear_solves = LinearSolveStats{10, 25, 4, 0.5, 3, 0.25, 0.125};
   summary.rest = RestSummary{1e-6, 2.0, 840};
   const std::string json = to_json(summary);
-  EXPECT_NE(json.find(R"("linear_solves": {"solves": 10, "iterations": 25, "mean_iterations": 2.5, "most_iterations": 4, "jacobian_seconds": 0.5, "solve_seconds": 0.25},)"),
+  EXPECT_NE(json.find(R"("linear_solves": {"solves": 10, "iterations": 25, "mean_iterations": 2.5, "most_iterations": 4, "jacobian_seconds": 0.5, "jacobians": 3, "solve_seconds": 0.25, "setup_seconds": 0.125},)"),
             std::string::npos)
       << json;
   EXPECT_NE(json.find(R"("rest": {"fraction": 1e-06, "peak_kinetic_energy": 2, "step": 840})"),

@@ -404,9 +404,9 @@ TEST(Scene, PublishedCalibrationsKeepTheirNumbers) {
 
 TEST(Scene, IntegratorNamesFollowTheEnum) {
   const auto& names = integrator_names();
-  ASSERT_EQ(names.size(), 10u);
+  ASSERT_EQ(names.size(), 11u);
   EXPECT_EQ(names.front(), "verlet");
-  EXPECT_EQ(names.back(), "semi-implicit");
+  EXPECT_EQ(names.back(), "semi-implicit-2");
   for (const auto& name : names) EXPECT_EQ(integrator_name(*integrator_from_name(name)), name);
   EXPECT_EQ(integrator_from_name("tc-verlet"), Integrator::tc_verlet);
   EXPECT_FALSE(integrator_from_name("Verlet").has_value());
@@ -416,7 +416,9 @@ TEST(Scene, IntegratorNamesFollowTheEnum) {
 TEST(Scene, SolverTable) {
   SceneText text;
   text.time += "integrator = \"semi-implicit\"\n";
-  text.tail = "[time.solver]\nksp = \"cg\"\npc = \"jacobi\"\nrtol = 1e-8\nmax_iterations = 50\n";
+  text.tail =
+      "[time.solver]\nksp = \"cg\"\npc = \"jacobi\"\nrtol = 1e-8\nmax_iterations = 50\n"
+      "jacobian_every = 5\n";
 #if defined(COSSERAT_HAVE_PETSC)
   const Scene scene = parse(text);
   EXPECT_EQ(scene.solver.ksp, "cg");
@@ -424,6 +426,9 @@ TEST(Scene, SolverTable) {
   EXPECT_EQ(scene.solver.rtol, 1e-8);
   EXPECT_EQ(scene.solver.atol, LinearSolver{}.atol);
   EXPECT_EQ(scene.solver.max_iterations, 50);
+  EXPECT_EQ(scene.solver.jacobian_every, 5);
+  EXPECT_EQ(parse(text, {"time.integrator=semi-implicit-2"}).integrator,
+            Integrator::semi_implicit_2);
   EXPECT_TRUE(scene.warnings.empty());
   // Read by the semi-implicit integrator only: with another, a warning, not an error.
   const Scene explicit_scene = parse(text, {"time.integrator=verlet"});
@@ -435,6 +440,9 @@ TEST(Scene, SolverTable) {
   text.tail = "[time.solver]\nrtol = 0.0\n";
   EXPECT_THAT(error_of(text, {"time.integrator=verlet"}),
               AllOf(HasSubstr("time.solver.rtol"), HasSubstr("> 0")));
+  text.tail = "[time.solver]\njacobian_every = 0\n";
+  EXPECT_THAT(error_of(text, {"time.integrator=verlet"}),
+              AllOf(HasSubstr("time.solver.jacobian_every"), HasSubstr("1")));
   text.tail = "[time.solver]\ntolerance = 1e-8\n";
   EXPECT_THAT(error_of(text, {"time.integrator=verlet"}),
               AllOf(HasSubstr("time.solver.tolerance"), HasSubstr("allowed here")));

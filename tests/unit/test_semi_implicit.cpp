@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "cosserat/model/wave_speed.hpp"
@@ -130,6 +132,33 @@ TEST(SemiImplicit, CountsItsSolves) {
   scene.integrator = Integrator::verlet;
   Simulation explicit_run(scene, MPI_COMM_SELF, any_scheme);
   EXPECT_FALSE(explicit_run.stepper().linear_solves().has_value());
+}
+
+// time.solver.jacobian_every = 4 builds a Jacobian on steps 0, 4 and 8 of 12 and solves with
+// it (and its preconditioner) until the next: the trajectory stays within the linearisation's
+// error of the one that builds every step, and is not the same.
+TEST(SemiImplicit, KeepsItsJacobianForTheStepsAsked) {
+  Scene scene = busy_sheet(Integrator::semi_implicit);
+  Simulation every_step(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(every_step, 12));
+  EXPECT_EQ(every_step.stepper().linear_solves()->jacobians, 12);
+  scene.solver.jacobian_every = 4;
+  Simulation kept(scene, MPI_COMM_SELF, any_scheme);
+  ASSERT_TRUE(testing::advance(kept, 12));
+  EXPECT_EQ(kept.stepper().linear_solves()->jacobians, 3);
+  EXPECT_EQ(kept.stepper().linear_solves()->solves, 12);
+  const Simulation start(scene, MPI_COMM_SELF, any_scheme);
+  double apart = 0.0, moved = 0.0;
+  for (int l = 0; l < scene.n; ++l)
+    for (int k = 0; k < scene.m; ++k) {
+      const Vec3 r = every_step.positions()(k, l);
+      apart = std::max(apart, norm(kept.positions()(k, l) - r));
+      moved = std::max(moved, norm(r - start.positions()(k, l)));
+    }
+  std::printf("[jacobian_every] 4: %.3g m from building every step, which moved %.3g m\n",
+              apart, moved);
+  EXPECT_GT(apart, 1e-12);
+  EXPECT_LT(apart, 1e-2 * moved);
 }
 
 // A solver name PETSc does not know is bad input, found before the first step.

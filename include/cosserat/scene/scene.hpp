@@ -106,6 +106,7 @@ struct LinearSolver {
   double rtol = 1e-10;
   double atol = 1e-50;  // PETSc's default: the relative test decides
   long max_iterations = 1000;
+  long jacobian_every = 1;  // steps a Jacobian and its preconditioner serve
 };
 
 // The per-node fields a run can write beside its positions (docs/output.md, "Fields"), in the

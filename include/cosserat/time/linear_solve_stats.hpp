@@ -10,7 +10,9 @@ struct LinearSolveStats {
   long iterations = 0;       // summed over the solves
   long most_iterations = 0;  // in one solve
   double jacobian_seconds = 0.0;
+  long jacobians = 0;  // built; fewer than the solves with time.solver.jacobian_every > 1
   double solve_seconds = 0.0;
+  double setup_seconds = 0.0;  // of solve_seconds, the preconditioner's set-up
 };
 
 }  // namespace cosserat
