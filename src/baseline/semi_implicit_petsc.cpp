@@ -12,6 +12,7 @@
 #include <chrono>
 #include <source_location>
 #include <stdexcept>
+#include <string>
 
 #include "cosserat/baseline/semi_implicit.hpp"
 #include "semi_implicit_solver.hpp"
@@ -423,8 +424,22 @@ std::optional<std::string> SemiImplicitSolver::solve(
   s.stats.most_iterations = std::max<long>(s.stats.most_iterations, iterations);
   s.stats.solve_seconds += seconds_since(start);
   if (reason < 0) {
-    return fmt::format("the linear solver did not converge ({} after {} iterations)",
-                       KSPConvergedReasons[reason], iterations);
+    KSPType ksp_type;
+    PCType pc_type;
+    PC pc;
+    check(KSPGetType(s.ksp, &ksp_type));
+    check(KSPGetPC(s.ksp, &pc));
+    check(PCGetType(pc, &pc_type));
+    // On large sheets block Jacobi stops converging where multigrid does not
+    // (docs/semi-implicit.md, "Preconditioners, against grid size").
+    const bool multigrid = std::string(pc_type) == PCGAMG || std::string(pc_type) == PCHYPRE;
+    const std::string hint =
+        s.exact && !multigrid
+            ? "; on a large sheet, [time.solver] ksp = \"cg\" with pc = \"gamg\" scales "
+              "(docs/semi-implicit.md)"
+            : "";
+    return fmt::format("the linear solver did not converge ({} after {} iterations, {} with {}){}",
+                       KSPConvergedReasons[reason], iterations, ksp_type, pc_type, hint);
   }
   return std::nullopt;
 }

@@ -634,10 +634,10 @@ void read_time(const Table& time, Scene& scene) {
   }
   if (const auto solver = time.find_table("solver")) {
     scene.solver = read_solver(*solver);
-    // A sweep over integrators keeps the table; only the semi-implicit one reads it.
+    // A sweep over integrators keeps the table; only the semi-implicit ones read it.
     if (!is_semi_implicit(scene.integrator)) {
       scene.warnings.push_back(
-          "[time.solver] is read by the semi-implicit integrator only; ignored for " +
+          "[time.solver] is read by the semi-implicit integrators only; ignored for " +
           integrator_name(scene.integrator));
     }
   }
