@@ -154,7 +154,10 @@ SemiImplicitSolver::Impl::Impl(const Scene& scene, const Decomposition& decompos
 
   check(KSPCreate(bl.comm, &ksp));
   check(KSPSetOperators(ksp, system, system));
-  const LinearSolver& linear = scene.solver;
+  LinearSolver linear = scene.solver;
+  const KrylovChoice choice = default_linear_solver(exact, static_cast<long>(bl.m) * bl.n);
+  if (linear.ksp.empty()) linear.ksp = choice.ksp;
+  if (linear.pc.empty()) linear.pc = choice.pc;
   set_or_refuse([&] { return KSPSetType(ksp, linear.ksp.c_str()); },
                 fmt::format("{}: time.solver.ksp: PETSc has no Krylov method \"{}\" (for example "
                             "gmres, fgmres, bcgs, cg, richardson)",
@@ -445,6 +448,13 @@ std::optional<std::string> SemiImplicitSolver::solve(
 }
 
 const LinearSolveStats& SemiImplicitSolver::stats() const { return impl_->stats; }
+
+KrylovChoice default_linear_solver(bool exact_jacobian, long nodes) {
+  // benchmarks/results/semi-implicit-grids-vm-2026-12-05.md: on 240² the two cost the same.
+  constexpr long kMultigridNodes = 240L * 240L;
+  if (exact_jacobian && nodes >= kMultigridNodes) return {"cg", "gamg"};
+  return {"gmres", "bjacobi"};
+}
 
 void add_petsc_options(const std::string& options) {
   start_petsc();

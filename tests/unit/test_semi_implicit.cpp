@@ -161,6 +161,23 @@ TEST(SemiImplicit, KeepsItsJacobianForTheStepsAsked) {
   EXPECT_LT(apart, 1e-2 * moved);
 }
 
+// Without ksp and pc the baseline takes cg with gamg only where block Jacobi stalls and gamg
+// works: an exact (energy-form) Jacobian on a grid of 240 × 240 nodes or more
+// (docs/semi-implicit.md, "Preconditioners, against grid size").
+TEST(SemiImplicit, ChoosesMultigridForLargeSheetsOfTheEnergyForm) {
+  const KrylovChoice small = default_linear_solver(true, 239L * 240L);
+  EXPECT_EQ(small.ksp, "gmres");
+  EXPECT_EQ(small.pc, "bjacobi");
+  const KrylovChoice large = default_linear_solver(true, 240L * 240L);
+  EXPECT_EQ(large.ksp, "cg");
+  EXPECT_EQ(large.pc, "gamg");
+  const KrylovChoice differenced = default_linear_solver(false, 1000L * 1000L);
+  EXPECT_EQ(differenced.ksp, "gmres");
+  EXPECT_EQ(differenced.pc, "bjacobi");
+  EXPECT_TRUE(LinearSolver{}.ksp.empty());
+  EXPECT_TRUE(LinearSolver{}.pc.empty());
+}
+
 // A solver name PETSc does not know is bad input, found before the first step.
 TEST(SemiImplicit, UnknownKrylovMethodIsASceneError) {
   Scene scene = busy_sheet(Integrator::semi_implicit);

@@ -101,8 +101,10 @@ struct Fluid {
 // [time.solver]: the linear solver of the semi-implicit integrator, in PETSc's names. PETSc's
 // own -ksp_* and -pc_* options (command line or PETSC_OPTIONS) override these.
 struct LinearSolver {
-  std::string ksp = "gmres";
-  std::string pc = "bjacobi";  // block Jacobi with ILU(0) blocks: one block per rank
+  // Empty: the baseline chooses by the grid and its Jacobian (default_linear_solver in
+  // cosserat/baseline/semi_implicit.hpp).
+  std::string ksp;
+  std::string pc;
   double rtol = 1e-10;
   double atol = 1e-50;  // PETSc's default: the relative test decides
   long max_iterations = 1000;
