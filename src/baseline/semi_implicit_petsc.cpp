@@ -8,7 +8,6 @@
 #include <petscksp.h>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <source_location>
 #include <stdexcept>
@@ -74,6 +73,11 @@ struct SemiImplicitSolver::Impl {
   void set_up_colouring(const Scene& scene);
   void copy_in(const Field<Vec3>& field, Vec v) const;
   void copy_out(Vec v, Field<Vec3>& field) const;
+  // The factor each row of the system is multiplied by: the node's mass over the interior
+  // mass with the exact Jacobian, 1 with a differenced one.
+  double row_weight(int k, int l) const {
+    return exact ? dynamics->model().node_mass().weight(k, l) : 1.0;
+  }
   // −Σ_p ∂²E_p/∂r∂r over the interior mass into the owned rows of `jacobian`.
   void assemble_hessians(const Field<Vec3>& r);
 
@@ -142,10 +146,9 @@ SemiImplicitSolver::Impl::Impl(const Scene& scene, const Decomposition& decompos
   check(VecDuplicate(x, &shift));
   {
     Field<Vec3> w(bl);
-    const NodeMass& mass = dynamics->model().node_mass();
     for (int l = bl.l0; l < bl.l1; ++l)
       for (int k = bl.k0; k < bl.k1; ++k) {
-        const double weight = exact ? mass.weight(k, l) : 1.0;
+        const double weight = row_weight(k, l);
         w(k, l) = Vec3{weight, weight, weight};
       }
     copy_in(w, weights);
@@ -268,33 +271,22 @@ SemiImplicitSolver::SemiImplicitSolver(const Scene& scene, const Decomposition& 
 SemiImplicitSolver::~SemiImplicitSolver() = default;
 
 // Each node p's Hessian adds into the rows of the owned nodes of its box, so a block takes the
-// p of its owned nodes and of the ring around them (their E_p read two nodes out: the ghosts).
-// An interior p's energy reads six nodes of its box (CosseratEnergy::node_hessian), a border
-// node's any of the nine.
+// p of its owned nodes and of the ring around them (their E_p read two nodes out: the ghosts),
+// over the slots each E_p reads.
 void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   const Block& bl = *block;
   const ForceModel& model = dynamics->model();
   const double scale = -1.0 / model.node_mass().interior;
-  constexpr int kRead[6] = {1, 3, 4, 5, 7, 8};  // slots 3 (dl + 1) + (dk + 1) of (0,−1) … (1,1)
-  std::array<double, 27 * 27> h;
+  NodeHessian h;
   std::vector<PetscScalar> values;
   check(MatZeroEntries(jacobian));
   for (int l = std::max(bl.l0 - 1, 0); l < std::min(bl.l1 + 1, bl.n); ++l)
     for (int k = std::max(bl.k0 - 1, 0); k < std::min(bl.k1 + 1, bl.m); ++k) {
       model.node_hessian(r, k, l, h);
-      const bool interior = k > 0 && k < bl.m - 1 && l > 0 && l < bl.n - 1;
-      int slots[9], count = 0;
-      if (interior)
-        for (const int a : kRead) slots[count++] = a;
-      else
-        for (int a = 0; a < 9; ++a) {
-          const int qk = k + a % 3 - 1, ql = l + a / 3 - 1;
-          if (qk >= 0 && qk < bl.m && ql >= 0 && ql < bl.n) slots[count++] = a;
-        }
       MatStencil rows[9], columns[9];
       int row_slots[9], row_count = 0;
-      for (int i = 0; i < count; ++i) {
-        const int a = slots[i], qk = k + a % 3 - 1, ql = l + a / 3 - 1;
+      for (int i = 0; i < h.count; ++i) {
+        const int a = h.read[i], qk = k + a % 3 - 1, ql = l + a / 3 - 1;
         columns[i] = MatStencil{0, ql, qk, 0};
         if (bl.owns(qk, ql)) {
           rows[row_count] = columns[i];
@@ -302,16 +294,16 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
         }
       }
       if (row_count == 0) continue;
-      values.resize(static_cast<std::size_t>(9 * row_count * count));
+      values.resize(static_cast<std::size_t>(9 * row_count * h.count));
       std::size_t v = 0;
       for (int ri = 0; ri < row_count; ++ri)
         for (int i = 0; i < 3; ++i)
-          for (int ci = 0; ci < count; ++ci)
+          for (int ci = 0; ci < h.count; ++ci)
             for (int j = 0; j < 3; ++j)
-              values[v++] = scale * h[static_cast<std::size_t>((3 * row_slots[ri] + i) * 27 +
-                                                                3 * slots[ci] + j)];
-      check(MatSetValuesBlockedStencil(jacobian, row_count, rows, count, columns, values.data(),
-                                       ADD_VALUES));
+              values[v++] = scale * h.entries[static_cast<std::size_t>(
+                                        (3 * row_slots[ri] + i) * 27 + 3 * h.read[ci] + j)];
+      check(MatSetValuesBlockedStencil(jacobian, row_count, rows, h.count, columns,
+                                       values.data(), ADD_VALUES));
     }
   check(MatAssemblyBegin(jacobian, MAT_FINAL_ASSEMBLY));
   check(MatAssemblyEnd(jacobian, MAT_FINAL_ASSEMBLY));
@@ -373,10 +365,9 @@ std::optional<std::string> SemiImplicitSolver::solve(
   check(VecScale(s.shift, diagonal));
   check(MatDiagonalSet(s.system, s.shift, ADD_VALUES));
   if (terms.fluid > 0.0) {
-    const NodeMass& mass = s.dynamics->model().node_mass();
     for (int l = bl.l0; l < bl.l1; ++l)
       for (int k = bl.k0; k < bl.k1; ++k) {
-        const double weight = terms.fluid / (2.0 * dt) * (s.exact ? mass.weight(k, l) : 1.0);
+        const double weight = terms.fluid / (2.0 * dt) * s.row_weight(k, l);
         const Vec3 n = (*normals)(k, l);
         MatStencil node[3];
         PetscScalar block[9];

@@ -61,6 +61,11 @@ struct BasicCornerNormals {
   V n;
 };
 
+// The positions around (k, l) as corner_normals and trapezoidal_terms read them: at(dk, dl).
+inline auto around(const Field<Vec3>& R, int k, int l) {
+  return [&R, k, l](int dk, int dl) { return R(k + dk, l + dl); };
+}
+
 // `at(dk, dl)` is the position of the node (k + dk, l + dl) around p = (k, l).
 template <class V, class At>
 BasicCornerNormals<V> corner_normals(const At& at, const Neighbours& p,
@@ -290,22 +295,24 @@ auto CosseratEnergy::trapezoidal_terms(const At& at, int k, int l, std::array<V,
 double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
                                           StencilGradient* gradient, Vec3* normal, Parts* parts,
                                           bool node_terms) const {
-  return trapezoidal_terms(
-      [&R, k, l](int dk, int dl) { return R(k + dk, l + dl); }, k, l, gradient, normal, parts,
-      node_terms);
+  return trapezoidal_terms(around(R, k, l), k, l, gradient, normal, parts, node_terms);
 }
 
 // The gradient's code run on dual numbers seeded with the 27 coordinates of the box: each
 // gradient entry's derivatives are a row of the Hessian. An interior node reads six of the nine
-// nodes (energy_interior.hpp), so it takes 18 directions instead of 27.
+// nodes (energy_interior.hpp), so it takes 18 directions instead of 27. The slots the code reads
+// are the ones the Hessian has.
 // flatten: every dual operation inlined into one loop nest per operation, not a call each.
 template <int N>
 [[gnu::flatten]] void CosseratEnergy::stencil_hessian(const Field<Vec3>& R, int k, int l,
-                                     const int (&direction)[9], StencilHessian& H) const {
+                                                      const int (&direction)[9],
+                                                      NodeHessian& H) const {
   using Dual = energy::Dual<N>;
   using V = energy::DualVec3<N>;
+  bool read[9] = {};
   auto at = [&](int dk, int dl) {
     const int s = slot(dk, dl), first = 3 * direction[s];
+    read[s] = true;
     const Vec3 r = R(k + dk, l + dl);
     V v{Dual(r.x), Dual(r.y), Dual(r.z)};
     v.x.d[first] = 1.0, v.y.d[first + 1] = 1.0, v.z.d[first + 2] = 1.0;
@@ -313,19 +320,22 @@ template <int N>
   };
   std::array<V, 9> G;
   trapezoidal_terms(at, k, l, &G, static_cast<V*>(nullptr), nullptr, true);
-  H.fill(0.0);
+  H.count = 0;
+  for (int s = 0; s < 9; ++s)
+    if (read[s]) H.read[H.count++] = s;
+  H.entries.fill(0.0);
   for (int a = 0; a < 9; ++a)
     for (int i = 0; i < 3; ++i) {
       const Dual& g = i == 0 ? G[a].x : (i == 1 ? G[a].y : G[a].z);
-      for (int b = 0; b < 9; ++b) {
-        if (direction[b] < 0) continue;
-        for (int j = 0; j < 3; ++j) H[(3 * a + i) * 27 + 3 * b + j] = g.d[3 * direction[b] + j];
+      for (int bi = 0; bi < H.count; ++bi) {
+        const int b = H.read[bi];
+        for (int j = 0; j < 3; ++j)
+          H.entries[(3 * a + i) * 27 + 3 * b + j] = g.d[3 * direction[b] + j];
       }
     }
 }
 
-void CosseratEnergy::node_hessian(const Field<Vec3>& R, int k, int l,
-                                  StencilHessian& hessian) const {
+void CosseratEnergy::node_hessian(const Field<Vec3>& R, int k, int l, NodeHessian& hessian) const {
   // Slots in slot() order: (−1,−1) (0,−1) (1,−1) (−1,0) (0,0) (1,0) (−1,1) (0,1) (1,1).
   static constexpr int kInterior[9] = {-1, 0, -1, 1, 2, 3, -1, 4, 5};
   static constexpr int kAll[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
@@ -345,8 +355,7 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   const Terms has = terms_of(p);
   const double h1 = h1_, h2 = h2_;
   const Tangents a = tangents(R, k, l, p, h1, h2);
-  const auto corners =
-      corner_normals<Vec3>([&R, k, l](int dk, int dl) { return R(k + dk, l + dl); }, p, interior_);
+  const auto corners = corner_normals<Vec3>(around(R, k, l), p, interior_);
   const Vec3 n = corners.n;
   if (normal != nullptr) *normal = n;
   const SecondDerivatives X = second_derivatives(R, k, l, p, h1, h2);

@@ -30,7 +30,7 @@ void ForceModel::restore_step_state(const std::vector<double>& state) {
     throw std::invalid_argument("the checkpoint holds a model state this model does not have");
 }
 
-void ForceModel::node_hessian(const Field<Vec3>&, int, int, std::array<double, 27 * 27>&) const {
+void ForceModel::node_hessian(const Field<Vec3>&, int, int, NodeHessian&) const {
   throw std::logic_error("ForceModel::node_hessian: this model has no node Hessian");
 }
 
@@ -91,11 +91,11 @@ class EnergyForm final : public CosseratForm {
   void free_acceleration_rows(const Field<Vec3>& r, const Vec3& gravity,
                               const RowConsumer& consume) override {
     energy_.internal_force_rows(r, 1.0 / node_mass_.interior, gravity, consume);
-  }  bool has_node_hessian() const override {
+  }
+  bool has_node_hessian() const override {
     return energy_.quadrature() == Quadrature::trapezoidal;
   }
-  void node_hessian(const Field<Vec3>& r, int k, int l,
-                    std::array<double, 27 * 27>& hessian) const override {
+  void node_hessian(const Field<Vec3>& r, int k, int l, NodeHessian& hessian) const override {
     energy_.node_hessian(r, k, l, hessian);
   }
 };

@@ -410,7 +410,7 @@ TEST(EnergyForm, NodeHessiansAreTheDerivativeOfTheForce) {
     }
     const int m = s.m, n = s.n, size = 3 * m * n;
     std::vector<double> H(static_cast<std::size_t>(size) * size, 0.0);
-    CosseratEnergy::StencilHessian h;
+    NodeHessian h;
     for (int l = 0; l < n; ++l)
       for (int k = 0; k < m; ++k) {
         sheet.energy.node_hessian(sheet.r, k, l, h);
@@ -422,7 +422,7 @@ TEST(EnergyForm, NodeHessiansAreTheDerivativeOfTheForce) {
             for (int i = 0; i < 3; ++i)
               for (int j = 0; j < 3; ++j)
                 H[static_cast<std::size_t>(3 * (al * m + ak) + i) * size + 3 * (bl * m + bk) + j] +=
-                    h[static_cast<std::size_t>((3 * a + i) * 27 + 3 * b + j)];
+                    h.entries[static_cast<std::size_t>((3 * a + i) * 27 + 3 * b + j)];
           }
       }
     Field<Vec3> up(sheet.block), down(sheet.block);

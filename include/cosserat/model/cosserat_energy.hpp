@@ -11,6 +11,7 @@
 #include "cosserat/grid/threads.hpp"
 #include "cosserat/grid/wide_copy.hpp"
 #include "cosserat/model/cosserat_model.hpp"
+#include "cosserat/model/node_hessian.hpp"
 #include "cosserat/model/node_mass.hpp"
 #include "cosserat/grid/vec3.hpp"
 
@@ -119,13 +120,10 @@ class CosseratEnergy {
   double node_energy(const Field<Vec3>& positions, int k, int l, StencilGradient* gradient,
                      Vec3* normal = nullptr, Parts* parts = nullptr) const;
 
-  // ∂²E_p/∂r_a∂r_b for the nodes a, b of p's 3 × 3 box (slots as node_energy's): the entry
-  // for component i of slot a and j of slot b is at (3a + i) · 27 + 3b + j, and a slot outside
-  // the grid has zero rows and columns. The exact derivative of node_energy's gradient, by
-  // forward-mode differentiation of the same code (docs/semi-implicit.md, "The Jacobian");
-  // trapezoidal quadrature only.
-  using StencilHessian = std::array<double, 27 * 27>;
-  void node_hessian(const Field<Vec3>& positions, int k, int l, StencilHessian& hessian) const;
+  // ∂²E_p/∂r∂r over p's 3 × 3 box (NodeHessian): the exact derivative of node_energy's
+  // gradient, by forward-mode differentiation of the same code (docs/semi-implicit.md, "The
+  // Jacobian"); trapezoidal quadrature only.
+  void node_hessian(const Field<Vec3>& positions, int k, int l, NodeHessian& hessian) const;
 
   // The threads' bands of owned rows, which follow the threads' speeds. Public for the tests that
   // hold the forces to the same bits on every split.
@@ -184,7 +182,7 @@ class CosseratEnergy {
   // node_hessian with N directions; direction[s] is the seed of slot s (−1: not read).
   template <int N>
   void stencil_hessian(const Field<Vec3>& positions, int k, int l, const int (&direction)[9],
-                       StencilHessian& hessian) const;
+                       NodeHessian& hessian) const;
 
   const Block* block_;
   double h1_, h2_;

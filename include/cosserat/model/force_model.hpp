@@ -4,7 +4,6 @@
 // node masses, the explicit step the model allows and how far its stencil reaches. time/ sees
 // this type only; make_force_model builds one from the scene's model section (ModelSpec).
 
-#include <array>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -12,6 +11,7 @@
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/vec3.hpp"
 #include "cosserat/model/model_spec.hpp"
+#include "cosserat/model/node_hessian.hpp"
 #include "cosserat/model/node_mass.hpp"
 
 namespace cosserat {
@@ -83,12 +83,11 @@ class ForceModel {
 
   // Where the force is the exact gradient of an energy that is a sum of node terms E_p over
   // each node's 3 × 3 box (the trapezoidal energy form): whether the model has E_p's exact
-  // Hessian, and its blocks at (k, l) as CosseratEnergy::node_hessian lays them out. Reads the
+  // Hessian at (k, l) with the slots it reads (NodeHessian). Reads the
   // ghosts of r up to reach() nodes out. The semi-implicit step assembles its Jacobian from
   // them (docs/semi-implicit.md, "The Jacobian").
   virtual bool has_node_hessian() const { return false; }
-  virtual void node_hessian(const Field<Vec3>& r, int k, int l,
-                            std::array<double, 27 * 27>& hessian) const;
+  virtual void node_hessian(const Field<Vec3>& r, int k, int l, NodeHessian& hessian) const;
 
   // This block's share of the stored energy (J), the nodes it owns summed in a fixed order;
   // reads the ghosts one node out.
