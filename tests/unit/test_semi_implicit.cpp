@@ -161,17 +161,21 @@ TEST(SemiImplicit, KeepsItsJacobianForTheStepsAsked) {
   EXPECT_LT(apart, 1e-2 * moved);
 }
 
-// Without ksp and pc the baseline takes cg with gamg only where block Jacobi stalls and gamg
-// works: an exact (energy-form) Jacobian on a grid of 240 × 240 nodes or more
-// (docs/semi-implicit.md, "Preconditioners, against grid size").
+// Without ksp and pc the baseline takes cg with hypre's BoomerAMG only where block Jacobi
+// stalls and BoomerAMG converges: an exact (energy-form) Jacobian on a grid of 240 × 240 nodes
+// or more, from a PETSc built with hypre (docs/semi-implicit.md, "Preconditioners, against
+// grid size").
 TEST(SemiImplicit, ChoosesMultigridForLargeSheetsOfTheEnergyForm) {
-  const KrylovChoice small = default_linear_solver(true, 239L * 240L);
+  const KrylovChoice small = default_linear_solver(true, 239L * 240L, true);
   EXPECT_EQ(small.ksp, "gmres");
   EXPECT_EQ(small.pc, "bjacobi");
-  const KrylovChoice large = default_linear_solver(true, 240L * 240L);
+  const KrylovChoice large = default_linear_solver(true, 240L * 240L, true);
   EXPECT_EQ(large.ksp, "cg");
-  EXPECT_EQ(large.pc, "gamg");
-  const KrylovChoice differenced = default_linear_solver(false, 1000L * 1000L);
+  EXPECT_EQ(large.pc, "hypre");
+  const KrylovChoice without_hypre = default_linear_solver(true, 480L * 480L, false);
+  EXPECT_EQ(without_hypre.ksp, "gmres");
+  EXPECT_EQ(without_hypre.pc, "bjacobi");
+  const KrylovChoice differenced = default_linear_solver(false, 1000L * 1000L, true);
   EXPECT_EQ(differenced.ksp, "gmres");
   EXPECT_EQ(differenced.pc, "bjacobi");
   EXPECT_TRUE(LinearSolver{}.ksp.empty());

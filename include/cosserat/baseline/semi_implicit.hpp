@@ -24,16 +24,16 @@ namespace cosserat {
 // every scheme this build has.
 std::unique_ptr<Scheme> any_scheme(const SchemeSetup& setup);
 
-// The Krylov method and preconditioner of a [time.solver] that names none: cg with smoothed
-// aggregation (gamg) for an exact, symmetric Jacobian on a grid of at least 240 × 240 nodes,
-// where block Jacobi needs hundreds of iterations and from 480 × 480 on does not converge;
-// gmres with block Jacobi (ILU(0) blocks) otherwise, which converges on every model and on
-// small grids where gamg does not (docs/semi-implicit.md, "Preconditioners, against grid
-// size").
+// The Krylov method and preconditioner of a [time.solver] that names none: cg with hypre's
+// BoomerAMG for an exact, symmetric Jacobian on a grid of at least 240 × 240 nodes, where
+// block Jacobi needs hundreds of iterations and from 480 × 480 on does not converge, and
+// PETSc's own smoothed aggregation (gamg) fails once the sheet has deformed; gmres with block
+// Jacobi (ILU(0) blocks) otherwise, and where PETSc was built without hypre
+// (docs/semi-implicit.md, "Preconditioners, against grid size").
 struct KrylovChoice {
   std::string ksp, pc;
 };
-KrylovChoice default_linear_solver(bool exact_jacobian, long nodes);
+KrylovChoice default_linear_solver(bool exact_jacobian, long nodes, bool have_hypre);
 
 // Adds PETSc options (e.g. "-ksp_type cg -pc_type jacobi") for solvers made
 // later, starting PETSc if needed. PETSC_OPTIONS in the environment is read
