@@ -19,7 +19,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 SCHEMES = ["verlet", "symplectic-euler", "euler", "midpoint", "rk4", "leapfrog",
-           "velocity-verlet", "tc-verlet", "verlet-lagged", "semi-implicit"]
+           "velocity-verlet", "tc-verlet", "verlet-lagged", "semi-implicit",
+           "semi-implicit-2"]
 TARGETS = [1e-2, 1e-4, 1e-6]
 
 
@@ -90,7 +91,7 @@ def plot(by, stem):
                 points = by[scene].get(scheme)
                 if not points:
                     continue
-                style = "--" if scheme == "semi-implicit" else "-"
+                style = "--" if scheme.startswith("semi-implicit") else "-"
                 ax.loglog([x_of(p) for p in points], [p[2] for p in points], style, marker="o",
                           markersize=3, label=scheme)
             ax.set_title(scene)

@@ -79,15 +79,15 @@ output_every = {every}
 {fix}"""
 
 
-class Study:
-    def __init__(self, args):
-        self.exe = args.exe
-        self.stem = args.out
-        self.workers = args.workers
-        self.work = Path(tempfile.mkdtemp(prefix="cosserat-parity-"))
+class LoggedStudy:
+    """A study's log, STEM.log, appended to (a study can be run a part at a time); each line
+    is printed too. The first line: the time and the command line. Also the environment of its
+    single-threaded runs, as root."""
+
+    def __init__(self, stem):
         self.env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
                         OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-        self.log = open(self.stem + ".log", "a")
+        self.log = open(str(stem) + ".log", "a")
         self.say(f"# {datetime.datetime.now().isoformat(timespec='seconds')}: "
                  + " ".join(sys.argv[1:]))
 
@@ -95,6 +95,15 @@ class Study:
         print(text, flush=True)
         self.log.write(text + "\n")
         self.log.flush()
+
+
+class Study(LoggedStudy):
+    def __init__(self, args):
+        self.exe = args.exe
+        self.stem = args.out
+        self.workers = args.workers
+        self.work = Path(tempfile.mkdtemp(prefix="cosserat-parity-"))
+        super().__init__(self.stem)
 
     def form(self, name):
         return f'model.discretisation="{name}"'

@@ -26,7 +26,6 @@ benchmarks/run_total_error.sh, which records the context. One cosserat process a
 
 import argparse
 import csv
-import datetime
 import json
 import math
 import os
@@ -41,7 +40,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from parity_study import s1_like_scene, write_csv
+from parity_study import LoggedStudy, s1_like_scene, write_csv
 
 DISCS = ["energy", "energy-nodal"]
 LABEL = {"energy": "trapezoidal (\"energy\")", "energy-nodal": "nodal (\"energy-nodal\")"}
@@ -83,25 +82,16 @@ def exact_hung(X):
     return 0.5 * X * (lam * w[None, :]).sum(axis=1)
 
 
-class Study:
+class Study(LoggedStudy):
     def __init__(self, args):
         self.exe = args.exe
         self.stem = args.out
         self.quick = args.quick
         self.keep = args.keep
         self.work = Path(tempfile.mkdtemp(prefix="cosserat-total-error-"))
-        self.env = dict(os.environ, OMP_NUM_THREADS="1", OMPI_ALLOW_RUN_AS_ROOT="1",
-                        OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-        self.log = open(self.stem + ".log", "a")
         self.count = 0
         self.kept = {}  # S1 runs' final positions by (discretisation, nodes, dt)
-        self.say(f"# {datetime.datetime.now().isoformat(timespec='seconds')}: "
-                 + " ".join(sys.argv[1:]))
-
-    def say(self, text):
-        print(text, flush=True)
-        self.log.write(text + "\n")
-        self.log.flush()
+        super().__init__(self.stem)
 
     def scene(self, text):
         self.count += 1
