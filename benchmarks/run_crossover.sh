@@ -32,7 +32,7 @@ for n in ${grids//,/ }; do
           --configs semi-implicit:1e-6:1,semi-implicit-2:1e-6:1,semi-implicit:1e-6:5,semi-implicit-2:1e-6:5 ;;
     120) study --grids 120 --cap 100 --max-steps 320 \
           --configs semi-implicit:1e-6:5,semi-implicit-2:1e-6:1,semi-implicit-2:1e-6:5 ;;
-    # Only the second-order step (the first needs 4 to 8 times its steps for 1e-2 on the grids
+    # Only the second-order step (the first needs 4 times its steps for 1e-2 m on the grids
     # below) and Jacobians kept 5 and 10 steps; 40 steps cost 11 times Verlet's run already.
     240) study --grids 240 --cap 15 --si-steps 20,40,80 \
           --configs semi-implicit-2:1e-6:5,semi-implicit-2:1e-6:10 ;;
