@@ -136,31 +136,8 @@ class Study:
 
     def run(self, label, scene, overrides, until_rest=None, timeout=None):
         """One `cosserat run` without frames but the first and last: (summary, final positions)."""
-        stem = self.work / file_name(label)
-        command = [self.exe, "run", scene, "-q", "-o", f"{stem}.h5", "--summary",
-                   f"{stem}.json"]
-        for o in overrides:
-            command += ["--set", o]
-        if until_rest:
-            command += ["--until-rest", str(until_rest)]
-        try:
-            done = subprocess.run(command, env=self.env, capture_output=True, text=True,
-                                  timeout=timeout)
-        except subprocess.TimeoutExpired:
-            return {"status": "timed out", "exit_status": None}, None
-        summary = {"status": "no summary"}
-        if Path(f"{stem}.json").exists():
-            summary = json.loads(Path(f"{stem}.json").read_text())
-        summary["exit_status"] = done.returncode
-        if done.returncode not in (0, 3):
-            summary["status"] = f"exit {done.returncode}: {done.stderr.strip()[-200:]}"
-        positions = None
-        if Path(f"{stem}.h5").exists() and done.returncode == 0:
-            with h5py.File(f"{stem}.h5", "r") as f:
-                positions = f["positions"][-1].reshape(-1, 3)
-        for suffix in (".h5", ".xmf", ".json"):
-            Path(f"{stem}{suffix}").unlink(missing_ok=True)
-        return summary, positions
+        return run_cosserat(self.exe, self.env, self.work / file_name(label), scene, overrides,
+                            until_rest, timeout)
 
     # ------------------------------------------------------------------------------------------
     # Accuracy
@@ -251,6 +228,34 @@ class Study:
         schemes = [s for s in SCHEMES if limits.get(s, 0.0) > 0.0]
         with concurrent.futures.ThreadPoolExecutor(self.workers) as pool:
             return list(pool.map(one, schemes))
+
+
+def run_cosserat(exe, env, stem, scene, overrides, until_rest=None, timeout=None):
+    """One `cosserat run` of scene with the --set overrides, writing STEM.h5 and STEM.json and
+    removing them after: (summary, final positions, or None if the run did not end cleanly).
+    The summary's status says why a run failed."""
+    command = [exe, "run", str(scene), "-q", "-o", f"{stem}.h5", "--summary", f"{stem}.json"]
+    for o in overrides:
+        command += ["--set", o]
+    if until_rest:
+        command += ["--until-rest", str(until_rest)]
+    try:
+        done = subprocess.run(command, env=env, capture_output=True, text=True, timeout=timeout)
+    except subprocess.TimeoutExpired:
+        return {"status": "timed out", "exit_status": None}, None
+    summary = {"status": "no summary"}
+    if Path(f"{stem}.json").exists():
+        summary = json.loads(Path(f"{stem}.json").read_text())
+    summary["exit_status"] = done.returncode
+    if done.returncode not in (0, 3):
+        summary["status"] = f"exit {done.returncode}: {done.stderr.strip()[-200:]}"
+    positions = None
+    if Path(f"{stem}.h5").exists() and done.returncode == 0:
+        with h5py.File(f"{stem}.h5", "r") as f:
+            positions = f["positions"][-1].reshape(-1, 3)
+    for suffix in (".h5", ".xmf", ".json"):
+        Path(f"{stem}{suffix}").unlink(missing_ok=True)
+    return summary, positions
 
 
 def file_name(label):

@@ -40,9 +40,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-import h5py
 import numpy as np
 
+from accuracy_study import rms, run_cosserat
 from parity_study import LoggedStudy
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -76,29 +76,12 @@ class Study(LoggedStudy):
 
     def run(self, n, integrator, dt, steps, rtol=None, every=None):
         """One run to T with frames at 0 and T: (summary, positions at T or None)."""
-        stem = self.work / f"{n}-{integrator}-{steps}-{rtol}-{every}"
-        command = [self.exe, "run", str(self.scene(n)), "-q", "--threads", "1", "-o",
-                   f"{stem}.h5", "--summary", f"{stem}.json",
-                   "--set", f'time.integrator="{integrator}"', "--set", f"time.dt={dt!r}",
-                   "--set", f"time.steps={steps}", "--set", f"time.output_every={steps}"]
+        overrides = [f'time.integrator="{integrator}"', f"time.dt={dt!r}", f"time.steps={steps}",
+                     f"time.output_every={steps}"]
         if rtol is not None:
-            command += ["--set", f"time.solver.rtol={rtol!r}",
-                        "--set", f"time.solver.jacobian_every={every}"]
-        done = subprocess.run(command, env=self.env, capture_output=True, text=True)
-        summary = {"status": "no summary"}
-        if Path(f"{stem}.json").exists():
-            summary = json.loads(Path(f"{stem}.json").read_text())
-        if done.returncode != 0 and summary.get("status") == "ok":
-            summary["status"] = f"exit {done.returncode}"
-        if done.returncode not in (0, 3):
-            summary["status"] = f"exit {done.returncode}: {done.stderr.strip()[-200:]}"
-        positions = None
-        if done.returncode == 0 and Path(f"{stem}.h5").exists():
-            with h5py.File(f"{stem}.h5", "r") as f:
-                positions = np.array(f["positions"][-1]).reshape(-1, 3)
-        for suffix in (".h5", ".xmf", ".json"):
-            Path(f"{stem}{suffix}").unlink(missing_ok=True)
-        return summary, positions
+            overrides += [f"time.solver.rtol={rtol!r}", f"time.solver.jacobian_every={every}"]
+        stem = self.work / f"{n}-{integrator}-{steps}-{rtol}-{every}"
+        return run_cosserat(self.exe, self.env, stem, self.scene(n), overrides)
 
     def grid(self, n, reference_fraction, configs):
         h = 10.0 / (n - 1)
@@ -125,7 +108,7 @@ class Study(LoggedStudy):
             r = {"grid": n, "kind": kind, "integrator": integrator, "rtol": rtol,
                  "jacobian_every": every, "dt": self.T / steps, "steps": steps,
                  "wall_seconds": summary.get("wall_seconds"),
-                 "error": float(np.sqrt(np.mean(distance ** 2))) if distance is not None else "",
+                 "error": rms(positions - reference, 1.0) if distance is not None else "",
                  "max_error": float(distance.max()) if distance is not None else "",
                  "status": summary.get("status"),
                  "mean_iterations": solves.get("mean_iterations", ""),
@@ -166,8 +149,7 @@ class Study(LoggedStudy):
                 summary, positions = self.run(n, integrator, self.T / steps, steps, rtol, every)
                 mine.append((steps, summary, positions))
                 last_wall = summary.get("wall_seconds") or last_wall
-                if positions is not None and np.sqrt(np.mean(np.sum(
-                        (positions - reference) ** 2, axis=1))) < min(TARGETS):
+                if positions is not None and rms(positions - reference, 1.0) < min(TARGETS):
                     break
             return config, mine
 
