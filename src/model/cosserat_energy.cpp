@@ -299,19 +299,16 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
 }
 
 // The gradient's code run on dual numbers seeded with the 27 coordinates of the box: each
-// gradient entry's derivatives are a row of the Hessian. An interior node reads six of the nine
-// nodes (energy_interior.hpp), so it takes 18 directions instead of 27. The slots the code reads
-// are the ones the Hessian has.
+// gradient entry's derivatives are a row of the Hessian. The border nodes' way: an interior node
+// takes interior_hessian. The slots the code reads are the ones the Hessian has.
 // flatten: every dual operation inlined into one loop nest per operation, not a call each.
-template <int N>
 [[gnu::flatten]] void CosseratEnergy::stencil_hessian(const Field<Vec3>& R, int k, int l,
-                                                      const int (&direction)[9],
                                                       NodeHessian& H) const {
-  using Dual = energy::Dual<N>;
-  using V = energy::DualVec3<N>;
+  using Dual = energy::Dual<27>;
+  using V = energy::DualVec3<27>;
   bool read[9] = {};
   auto at = [&](int dk, int dl) {
-    const int s = slot(dk, dl), first = 3 * direction[s];
+    const int s = slot(dk, dl), first = 3 * s;
     read[s] = true;
     const Vec3 r = R(k + dk, l + dl);
     V v{Dual(r.x), Dual(r.y), Dual(r.z)};
@@ -330,19 +327,88 @@ template <int N>
       for (int bi = 0; bi < H.count; ++bi) {
         const int b = H.read[bi];
         for (int j = 0; j < 3; ++j)
-          H.entries[(3 * a + i) * 27 + 3 * b + j] = g.d[3 * direction[b] + j];
+          H.entries[(3 * a + i) * 27 + 3 * b + j] = g.d[3 * b + j];
       }
     }
 }
 
+// An interior node's E_p is the kernel's (energy_interior.hpp), a function of the five
+// differences r_q − r_p, and each neighbour q enters one of them alone: seeded with the five
+// neighbours and p held, the gradient's derivatives are the Hessian's rows at every slot and its
+// columns at the neighbours, 15 directions instead of the 18 of every slot. E_p does not change
+// when the box moves as a whole, so each row sums to zero over its slots: p's column is minus the
+// others' sum. It takes 5.2-5.8 µs a node on a bent 120² sheet, where stencil_hessian on the
+// 18 directions of the six slots took 11.8 (benchmarks/results/jacobian-vm-2026-12-05.md).
+template <bool Bending, bool Coupling>
+[[gnu::flatten]] void CosseratEnergy::interior_hessian(const Field<Vec3>& R, int k, int l,
+                                                       NodeHessian& H) const {
+  constexpr int N = 15;
+  using Dual = energy::Dual<N>;
+  using V = energy::DualVec3<N>;
+  auto at = [&](int dk, int dl, int direction) {
+    const Vec3 r = R(k + dk, l + dl);
+    V v{Dual(r.x), Dual(r.y), Dual(r.z)};
+    if (direction >= 0)
+      v.x.d[3 * direction] = v.y.d[3 * direction + 1] = v.z.d[3 * direction + 2] = 1.0;
+    return v;
+  };
+  V normal;
+  long crushed = 0;
+  const energy::BasicInteriorGradient<V> g =
+      energy::trapezoidal_gradient<Bending, Coupling, false, true>(
+          interior_, at(0, 0, -1), at(1, 0, 0), at(-1, 0, 1), at(0, 1, 2), at(0, -1, 3),
+          at(1, 1, 4), normal, crushed);
+  // The slots of g's members, and the seed of each slot (p's: none).
+  static constexpr int kSlots[6] = {4, 5, 3, 7, 1, 8};
+  static constexpr int kSeed[9] = {-1, 3, -1, 1, -1, 0, -1, 2, 4};
+  const V* rows[6] = {&g.centre, &g.right, &g.left, &g.up, &g.down, &g.up_right};
+  static constexpr int kRead[6] = {1, 3, 4, 5, 7, 8};
+  H.count = 6;
+  std::copy(std::begin(kRead), std::end(kRead), H.read);
+  H.entries.fill(0.0);
+  for (int ri = 0; ri < 6; ++ri) {
+    const int a = kSlots[ri];
+    for (int i = 0; i < 3; ++i) {
+      const Dual& gradient = i == 0 ? rows[ri]->x : (i == 1 ? rows[ri]->y : rows[ri]->z);
+      double* row = &H.entries[static_cast<std::size_t>((3 * a + i) * 27)];
+      double centre[3] = {0.0, 0.0, 0.0};
+      for (const int b : kRead) {
+        if (kSeed[b] < 0) continue;
+        for (int j = 0; j < 3; ++j) {
+          row[3 * b + j] = gradient.d[3 * kSeed[b] + j];
+          centre[j] -= row[3 * b + j];
+        }
+      }
+      for (int j = 0; j < 3; ++j) row[3 * 4 + j] = centre[j];
+    }
+  }
+}
+
+#if COSSERAT_WIDE_COPIES
+template <bool Bending, bool Coupling>
+[[gnu::target("avx2"), gnu::flatten]] void CosseratEnergy::interior_hessian_wide(
+    const Field<Vec3>& R, int k, int l, NodeHessian& H) const {
+  interior_hessian<Bending, Coupling>(R, k, l, H);
+}
+#endif
+
 void CosseratEnergy::node_hessian(const Field<Vec3>& R, int k, int l, NodeHessian& hessian) const {
-  // Slots in slot() order: (−1,−1) (0,−1) (1,−1) (−1,0) (0,0) (1,0) (−1,1) (0,1) (1,1).
-  static constexpr int kInterior[9] = {-1, 0, -1, 1, 2, 3, -1, 4, 5};
-  static constexpr int kAll[9] = {0, 1, 2, 3, 4, 5, 6, 7, 8};
-  if (geometry::neighbours(*block_, k, l).interior())
-    stencil_hessian<18>(R, k, l, kInterior, hessian);
+  if (!geometry::neighbours(*block_, k, l).interior()) {
+    stencil_hessian(R, k, l, hessian);
+    return;
+  }
+  const auto interior = [&]<bool Bending, bool Coupling>() {
+#if COSSERAT_WIDE_COPIES
+    if (wide_) return interior_hessian_wide<Bending, Coupling>(R, k, l, hessian);
+#endif
+    interior_hessian<Bending, Coupling>(R, k, l, hessian);
+  };
+  if (!terms_.bending)
+    interior.template operator()<false, false>();
+  else if (!terms_.coupling)
+    interior.template operator()<true, false>();
   else
-    stencil_hessian<27>(R, k, l, kAll, hessian);
+    interior.template operator()<true, true>();
 }
 
 // E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (docs/equations.md,

@@ -17,9 +17,11 @@
 namespace cosserat::energy {
 
 // The six nonzero slots of an interior node's gradient, ∂E_p/∂r_q for q = p + (dk, dl).
-struct InteriorGradient {
-  Vec3 centre, right, left, up, down, up_right;  // (0,0) (1,0) (−1,0) (0,1) (0,−1) (1,1)
+template <class V>
+struct BasicInteriorGradient {
+  V centre, right, left, up, down, up_right;  // (0,0) (1,0) (−1,0) (0,1) (0,−1) (1,1)
 };
+using InteriorGradient = BasicInteriorGradient<Vec3>;
 
 // A vector c made a unit one, u = c/g, with g = |c| except where the triangle or cell c spans
 // is crushed, |c| < δ (docs/equations.md, "Crushed cells"): there g = δ (3/8 + ¾y − ⅛y²),
@@ -184,40 +186,41 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded>
 // interior node's E_p is its bending terms, the stretch of its two forward edges and the cell
 // (k+½, l+½), all of weight 1; it reads the same six nodes. The coefficients are
 // trapezoidal_coefficients' (cosserat_energy.cpp), and trapezoidal_energy is the general form.
-template <bool Bending, bool Coupling, bool Normal, bool Bounded>
-[[gnu::always_inline]] inline InteriorGradient trapezoidal_gradient(
-    const InteriorCoefficients& c, const Vec3& r, const Vec3& r_right, const Vec3& r_left,
-    const Vec3& r_up, const Vec3& r_down, const Vec3& r_up_right, Vec3& normal, long& crushed) {
-  Vec3 g_right, g_left, g_up, g_down, g_up_right;
-  const Vec3 right = r_right - r, up = r_up - r, diagonal = r_up_right - r;
-  const double eps11 = c.e[0] * dot(right, right) - c.half_A[0];
-  const double eps22 = c.e[2] * dot(up, up) - c.half_A[2];
+template <bool Bending, bool Coupling, bool Normal, bool Bounded, class V>
+[[gnu::always_inline]] inline BasicInteriorGradient<V> trapezoidal_gradient(
+    const InteriorCoefficients& c, const V& r, const V& r_right, const V& r_left, const V& r_up,
+    const V& r_down, const V& r_up_right, V& normal, long& crushed) {
+  using S = ScalarOf<V>;
+  V g_right, g_left, g_up, g_down, g_up_right;
+  const V right = r_right - r, up = r_up - r, diagonal = r_up_right - r;
+  const S eps11 = c.e[0] * dot(right, right) - c.half_A[0];
+  const S eps22 = c.e[2] * dot(up, up) - c.half_A[2];
   // The cell's tangents at its centre, times 2h_α: ε₁₂ = e₁₂ t₁ · t₂ − ½A₁₂.
-  const Vec3 t1 = right + (diagonal - up), t2 = up + (diagonal - right);
-  const double eps12 = c.e[1] * dot(t1, t2) - c.half_A[1];
+  const V t1 = right + (diagonal - up), t2 = up + (diagonal - right);
+  const S eps12 = c.e[1] * dot(t1, t2) - c.half_A[1];
   // The coefficients of the forward edges in ∂E/∂D_α and of t₂, t₁ in ∂E/∂t₁, ∂E/∂t₂.
-  double nu11 = c.nu_eps[0] * eps11, nu12 = c.nu_eps[1] * eps12, nu22 = c.nu_eps[2] * eps22;
+  S nu11 = c.nu_eps[0] * eps11, nu12 = c.nu_eps[1] * eps12, nu22 = c.nu_eps[2] * eps22;
 
   if (Bending || Normal) {
-    const Vec3 left = r_left - r, down = r_down - r;
-    const Unit q0 = corner<Bounded>(right, up, c.corner, crushed),
+    const V left = r_left - r, down = r_down - r;
+    const BasicUnit<V> q0 = corner<Bounded>(right, up, c.corner, crushed),
                q1 = corner<Bounded>(up, left, c.corner, crushed),
                q2 = corner<Bounded>(left, down, c.corner, crushed),
                q3 = corner<Bounded>(down, right, c.corner, crushed);
-    const Unit sum =
+    const BasicUnit<V> sum =
         bounded_unit<Bounded>(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum, crushed);
-    const Vec3 n = sum.unit;
+    const V n = sum.unit;
     normal = n;
 
     if (Bending) {
-      const Vec3 d11 = right + left, d22 = up + down;
-      const double beta11 = dot(n, d11), beta22 = dot(n, d22);
-      double mu11 = c.mu_beta[0] * beta11, mu22 = c.mu_beta[2] * beta22;
+      const V d11 = right + left, d22 = up + down;
+      const S beta11 = dot(n, d11), beta22 = dot(n, d22);
+      S mu11 = c.mu_beta[0] * beta11, mu22 = c.mu_beta[2] * beta22;
       // The backward edges' coefficients, for the coupling's ε̄ alone.
-      double nu11_b = 0.0, nu22_b = 0.0;
+      S nu11_b = 0.0, nu22_b = 0.0;
       if (Coupling) {
-        const double eps11_b = c.e[0] * dot(left, left) - c.half_A[0];
-        const double eps22_b = c.e[2] * dot(down, down) - c.half_A[2];
+        const S eps11_b = c.e[0] * dot(left, left) - c.half_A[0];
+        const S eps22_b = c.e[2] * dot(down, down) - c.half_A[2];
         mu11 += c.mu_eps[0] * (0.5 * (eps11 + eps11_b));
         mu22 += c.mu_eps[2] * (0.5 * (eps22 + eps22_b));
         nu11_b = 0.5 * c.nu_beta[0] * beta11;
@@ -225,14 +228,14 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded>
         nu11 += nu11_b;
         nu22 += nu22_b;
       }
-      const Vec3 G_X11 = mu11 * n, G_X22 = mu22 * n;
+      const V G_X11 = mu11 * n, G_X22 = mu22 * n;
       g_right = G_X11;
       g_left = G_X11 + nu11_b * left;
       g_up = G_X22;
       g_down = G_X22 + nu22_b * down;
-      const Vec3 G_n = mu11 * d11 + mu22 * d22;
-      const Vec3 G_s = unit_gradient(sum, G_n);
-      const CornerGradient g0 = corner_gradient(q0, right, up, G_s),
+      const V G_n = mu11 * d11 + mu22 * d22;
+      const V G_s = unit_gradient(sum, G_n);
+      const BasicCornerGradient<V> g0 = corner_gradient(q0, right, up, G_s),
                            g1 = corner_gradient(q1, up, left, G_s),
                            g2 = corner_gradient(q2, left, down, G_s),
                            g3 = corner_gradient(q3, down, right, G_s);
@@ -246,16 +249,16 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded>
       g_right += g3.f;
 
       // The cell's twist: κ₁₂ = −n_c · X/(h₁h₂), n_c = t₁ × t₂ normalised.
-      const Vec3 X = (diagonal - right) - up;
-      const Unit cell = bounded_unit<Bounded>(cross(t1, t2), c.cell, crushed);
-      const double beta12 = dot(cell.unit, X);
-      double mu12 = c.mu_beta[1] * beta12;
+      const V X = (diagonal - right) - up;
+      const BasicUnit<V> cell = bounded_unit<Bounded>(cross(t1, t2), c.cell, crushed);
+      const S beta12 = dot(cell.unit, X);
+      S mu12 = c.mu_beta[1] * beta12;
       if (Coupling) {
         nu12 += c.nu_beta[1] * beta12;
         mu12 += c.mu_eps[1] * eps12;
       }
-      const Vec3 G_X = mu12 * cell.unit;
-      const CornerGradient gc = corner_gradient(cell, t1, t2, mu12 * X);
+      const V G_X = mu12 * cell.unit;
+      const BasicCornerGradient<V> gc = corner_gradient(cell, t1, t2, mu12 * X);
       // t₁ = r(k+1, l) + r(k+1, l+1) − r − r(k, l+1), t₂ = r(k, l+1) + r(k+1, l+1) − r −
       // r(k+1, l), X = r(k+1, l+1) − r(k+1, l) − r(k, l+1) + r.
       g_right += (gc.e - gc.f) - G_X;
@@ -267,7 +270,7 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded>
   g_right += nu11 * right + nu12 * (t2 - t1);
   g_up += nu22 * up + nu12 * (t1 - t2);
   g_up_right += nu12 * (t1 + t2);
-  const Vec3 g_centre = -((((g_right + g_left) + g_up) + g_down) + g_up_right);
+  const V g_centre = -((((g_right + g_left) + g_up) + g_down) + g_up_right);
   return {g_centre, g_right, g_left, g_up, g_down, g_up_right};
 }
 

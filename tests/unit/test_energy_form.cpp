@@ -397,12 +397,31 @@ TEST(EnergyForm, JacobianIsSymmetric) {
 // node_hessian, summed over the nodes, is the Hessian of E: exactly symmetric, and the derivative
 // of −force by central differences to their truncation error, on the deformed sheet with every
 // term and on the same sheet with a corner crushed to a hundredth of a spacing (the blend of
-// docs/equations.md, "Crushed cells"). A sign or a slot wrong in the differentiation shows as
-// an O(1) relative difference.
+// docs/equations.md, "Crushed cells"); also without the coupling φ and without bending, which
+// take their own interior code. A sign or a slot wrong in the differentiation shows as an O(1)
+// relative difference.
 TEST(EnergyForm, NodeHessiansAreTheDerivativeOfTheForce) {
-  for (const bool crush : {false, true}) {
-    SCOPED_TRACE(crush ? "a crushed corner" : "deformed");
-    Sheet sheet(coupled_sheet());
+  const auto uncoupled = [] {
+    Scene s = coupled_sheet();
+    s.material.phi = {0.0, 0.0, 0.0};
+    return s;
+  }();
+  const auto unbent = [&] {
+    Scene s = uncoupled;
+    s.material.xi = {0.0, 0.0, 0.0};
+    return s;
+  }();
+  struct Case {
+    const char* name;
+    Scene scene;
+    bool crush;
+  };
+  for (const Case& c : {Case{"deformed", coupled_sheet(), false},
+                        Case{"crushed", coupled_sheet(), true}, Case{"no phi", uncoupled, false},
+                        Case{"no xi, phi", unbent, false}}) {
+    SCOPED_TRACE(c.name);
+    const bool crush = c.crush;
+    Sheet sheet(c.scene);
     const Scene& s = sheet.scene;
     if (crush) {
       const Vec3 mid = 0.5 * (sheet.r(4, 3) + sheet.r(3, 4)), across = sheet.r(3, 3) - mid;
@@ -443,7 +462,7 @@ TEST(EnergyForm, NodeHessiansAreTheDerivativeOfTheForce) {
       }
     }
     std::printf("[hessian] %s: largest entry %.3e, off the differences by %.2e, asymmetry %.2e\n",
-                crush ? "crushed" : "deformed", largest, worst, asymmetry);
+                c.name, largest, worst, asymmetry);
     ASSERT_GT(largest, 1.0);
     EXPECT_LT(worst, 1e-6 * largest);
     EXPECT_LT(asymmetry, 1e-13 * largest);

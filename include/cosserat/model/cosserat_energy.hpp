@@ -179,10 +179,15 @@ class CosseratEnergy {
   template <class V, class At>
   auto trapezoidal_terms(const At& at, int k, int l, std::array<V, 9>* gradient, V* normal,
                          Parts* parts, bool node_terms) const;
-  // node_hessian with N directions; direction[s] is the seed of slot s (−1: not read).
-  template <int N>
-  void stencil_hessian(const Field<Vec3>& positions, int k, int l, const int (&direction)[9],
-                       NodeHessian& hessian) const;
+  // node_hessian of any node, seeded with every slot of its box (cosserat_energy.cpp).
+  void stencil_hessian(const Field<Vec3>& positions, int k, int l, NodeHessian& hessian) const;
+  // node_hessian of an interior node, through the kernel's trapezoidal_gradient; _wide is it
+  // compiled for AVX2, as interior_row_wide.
+  template <bool Bending, bool Coupling>
+  void interior_hessian(const Field<Vec3>& positions, int k, int l, NodeHessian& hessian) const;
+  template <bool Bending, bool Coupling>
+  void interior_hessian_wide(const Field<Vec3>& positions, int k, int l,
+                             NodeHessian& hessian) const;
 
   const Block* block_;
   double h1_, h2_;
