@@ -46,8 +46,7 @@ struct BentSheet {
 void node_hessians(benchmark::State& state) {
   const int nodes = static_cast<int>(state.range(0));
   omp_set_num_threads(1);
-  BentSheet sheet(nodes);
-  sheet.energy.set_wide_kernel(state.range(1) != 0);
+  const BentSheet sheet(nodes);
   NodeHessian h;
   for (auto _ : state) {
     for (int l = 0; l < nodes; ++l)
@@ -72,8 +71,7 @@ void internal_force(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<long>(nodes) * nodes);
 }
 
-// wide: 1 for the AVX2 copy where the CPU has it (the default), 0 for the build's baseline.
-BENCHMARK(node_hessians)->ArgNames({"nodes", "wide"})->Args({120, 1})->Args({120, 0})->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(node_hessians)->ArgName("nodes")->Arg(120)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK(internal_force)->ArgName("nodes")->Arg(120)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 }  // namespace

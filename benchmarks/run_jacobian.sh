@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# The exact Jacobian's node Hessians per node (bench_jacobian: the AVX2 copy and the portable
-# one) against one force evaluation, on a bent 120² sheet, one thread, in the release preset's
-# portable build that `cosserat` runs as, into benchmarks/results/jacobian-<host>-<date>.{json,md}
-# with the machine, compiler, git revision and date. The Jacobian's whole cost, with the PETSc
+# The exact Jacobian's node Hessians per node (bench_jacobian) against one force evaluation, on
+# a bent 120² sheet, one thread, in the release preset's portable build that `cosserat` runs as,
+# into benchmarks/results/jacobian-<host>-<date>.{json,md} with the machine, compiler, git
+# revision and date. The Jacobian's whole cost, with the PETSc
 # insertion, is the run summary's "Jacobian" time (docs/semi-implicit.md, "The Jacobian").
 #   benchmarks/run_jacobian.sh [extra Google Benchmark flags]
 set -euo pipefail

@@ -337,8 +337,9 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
 // neighbours and p held, the gradient's derivatives are the Hessian's rows at every slot and its
 // columns at the neighbours, 15 directions instead of the 18 of every slot. E_p does not change
 // when the box moves as a whole, so each row sums to zero over its slots: p's column is minus the
-// others' sum. It takes 5.2-5.8 µs a node on a bent 120² sheet, where stencil_hessian on the
-// 18 directions of the six slots took 11.8 (benchmarks/results/jacobian-vm-2026-12-05.md).
+// others' sum. It takes 5.8 µs a node on a bent 120² sheet, where stencil_hessian on the 18
+// directions of the six slots took 11.8 (benchmarks/results/jacobian-vm-2026-12-05.md); a copy
+// compiled for AVX2, as interior_row_wide, measured no faster and was dropped.
 template <bool Bending, bool Coupling>
 [[gnu::flatten]] void CosseratEnergy::interior_hessian(const Field<Vec3>& R, int k, int l,
                                                        NodeHessian& H) const {
@@ -384,31 +385,17 @@ template <bool Bending, bool Coupling>
   }
 }
 
-#if COSSERAT_WIDE_COPIES
-template <bool Bending, bool Coupling>
-[[gnu::target("avx2"), gnu::flatten]] void CosseratEnergy::interior_hessian_wide(
-    const Field<Vec3>& R, int k, int l, NodeHessian& H) const {
-  interior_hessian<Bending, Coupling>(R, k, l, H);
-}
-#endif
-
 void CosseratEnergy::node_hessian(const Field<Vec3>& R, int k, int l, NodeHessian& hessian) const {
   if (!geometry::neighbours(*block_, k, l).interior()) {
     stencil_hessian(R, k, l, hessian);
     return;
   }
-  const auto interior = [&]<bool Bending, bool Coupling>() {
-#if COSSERAT_WIDE_COPIES
-    if (wide_) return interior_hessian_wide<Bending, Coupling>(R, k, l, hessian);
-#endif
-    interior_hessian<Bending, Coupling>(R, k, l, hessian);
-  };
   if (!terms_.bending)
-    interior.template operator()<false, false>();
+    interior_hessian<false, false>(R, k, l, hessian);
   else if (!terms_.coupling)
-    interior.template operator()<true, false>();
+    interior_hessian<true, false>(R, k, l, hessian);
   else
-    interior.template operator()<true, true>();
+    interior_hessian<true, true>(R, k, l, hessian);
 }
 
 // E_p = h₁h₂ Σ_αβ (Φ^{αβ} ε_αβ² + Ψ^{αβ} κ_αβ² + Θ^{αβ} ε_αβ κ_αβ) (docs/equations.md,

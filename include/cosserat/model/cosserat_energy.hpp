@@ -181,13 +181,9 @@ class CosseratEnergy {
                          Parts* parts, bool node_terms) const;
   // node_hessian of any node, seeded with every slot of its box (cosserat_energy.cpp).
   void stencil_hessian(const Field<Vec3>& positions, int k, int l, NodeHessian& hessian) const;
-  // node_hessian of an interior node, through the kernel's trapezoidal_gradient; _wide is it
-  // compiled for AVX2, as interior_row_wide.
+  // node_hessian of an interior node, through the kernel's trapezoidal_gradient.
   template <bool Bending, bool Coupling>
   void interior_hessian(const Field<Vec3>& positions, int k, int l, NodeHessian& hessian) const;
-  template <bool Bending, bool Coupling>
-  void interior_hessian_wide(const Field<Vec3>& positions, int k, int l,
-                             NodeHessian& hessian) const;
 
   const Block* block_;
   double h1_, h2_;
