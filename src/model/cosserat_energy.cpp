@@ -337,7 +337,7 @@ double CosseratEnergy::trapezoidal_energy(const Field<Vec3>& R, int k, int l,
 // neighbours and p held, the gradient's derivatives are the Hessian's rows at every slot and its
 // columns at the neighbours, 15 directions instead of the 18 of every slot. E_p does not change
 // when the box moves as a whole, so each row sums to zero over its slots: p's column is minus the
-// others' sum. It takes 5.8 µs a node on a bent 120² sheet, where stencil_hessian on the 18
+// others' sum. It takes 5.2-6.2 µs a node on a bent 120² sheet, where stencil_hessian on the 18
 // directions of the six slots took 11.8 (benchmarks/results/jacobian-vm-2026-12-05.md); a copy
 // compiled for AVX2, as interior_row_wide, measured no faster and was dropped.
 template <bool Bending, bool Coupling>
