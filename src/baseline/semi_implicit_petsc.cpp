@@ -87,6 +87,7 @@ struct SemiImplicitSolver::Impl {
   // owned node of a row its 3 × 3 blocks, and the couplings that have one (a bit each).
   std::vector<double> rows_ahead;
   std::vector<std::uint32_t> coupled;
+  std::vector<NodeHessian> row_hessians;  // one row of nodes' Hessians, the block's and its ring's
 
   const Block* block;
   Dynamics* dynamics;
@@ -285,8 +286,8 @@ SemiImplicitSolver::~SemiImplicitSolver() = default;
 // over the slots each E_p reads. The p are taken row by row, and an owned row of nodes, whole
 // once the p of the row above it are in, goes into the matrix then, each node's row in one
 // call: inserted block by block as each p came, the insertion cost as much as the Hessians
-// (5.6 µs a node on 120², docs/semi-implicit.md). Every entry sums its p in the same order as
-// before, from zero, so the bits are those of adding them into a zeroed matrix.
+// (5.6 µs a node on 120², docs/semi-implicit.md). Every entry sums its p from zero in the order
+// of the p, row by row, on any decomposition and any threads: the matrix has the same bits.
 void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   const Block& bl = *block;
   const ForceModel& model = dynamics->model();
@@ -294,7 +295,6 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   const std::size_t width = static_cast<std::size_t>(bl.owned_k());
   rows_ahead.assign(3 * width * kCouplings * 9, 0.0);
   coupled.assign(3 * width, 0u);
-  NodeHessian h;
   // Row q of nodes into the matrix: each owned node's row, over the neighbours it couples to.
   const auto flush = [&](int q) {
     const std::size_t ring = static_cast<std::size_t>(q % 3) * width;
@@ -317,9 +317,15 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
     }
   };
   int next = bl.l0;  // the next owned row to go in
+  const int ka = std::max(bl.k0 - 1, 0), kb = std::min(bl.k1 + 1, bl.m);
+  row_hessians.resize(static_cast<std::size_t>(kb - ka));
   for (int l = std::max(bl.l0 - 1, 0); l < std::min(bl.l1 + 1, bl.n); ++l) {
-    for (int k = std::max(bl.k0 - 1, 0); k < std::min(bl.k1 + 1, bl.m); ++k) {
-      model.node_hessian(r, k, l, h);
+    // The row's Hessians on the threads, each a function of its box alone; summed in order
+    // below, so the bits do not depend on the threads.
+#pragma omp parallel for schedule(static)
+    for (int k = ka; k < kb; ++k) model.node_hessian(r, k, l, row_hessians[k - ka]);
+    for (int k = ka; k < kb; ++k) {
+      const NodeHessian& h = row_hessians[static_cast<std::size_t>(k - ka)];
       for (int ri = 0; ri < h.count; ++ri) {
         const int a = h.read[ri], qk = k + a % 3 - 1, ql = l + a / 3 - 1;
         if (!bl.owns(qk, ql)) continue;

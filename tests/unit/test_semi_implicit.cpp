@@ -3,6 +3,7 @@
 // test_integrators.cpp with every scheme.
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -159,6 +160,32 @@ TEST(SemiImplicit, KeepsItsJacobianForTheStepsAsked) {
               apart, moved);
   EXPECT_GT(apart, 1e-12);
   EXPECT_LT(apart, 1e-2 * moved);
+}
+
+// The exact Jacobian's node Hessians are taken on the threads and summed in the order of the
+// nodes (docs/semi-implicit.md, "The Jacobian"): on one thread and on three, the trajectory is
+// the same to the bit.
+TEST(SemiImplicit, ThreadsGiveTheSameBits) {
+  const Scene scene = busy_sheet(Integrator::semi_implicit_2);
+  const int threads_before = omp_get_max_threads();
+  omp_set_num_threads(1);
+  Simulation one(scene, MPI_COMM_SELF, any_scheme);
+  const bool one_ran = testing::advance(one, 12);
+  omp_set_num_threads(3);
+  Simulation three(scene, MPI_COMM_SELF, any_scheme);
+  const bool three_ran = testing::advance(three, 12);
+  omp_set_num_threads(threads_before);
+  ASSERT_TRUE(one_ran && three_ran);
+  ASSERT_EQ(one.stepper().linear_solves()->jacobians, 12);
+  const Simulation start(scene, MPI_COMM_SELF, any_scheme);
+  double moved = 0.0;
+  for (int l = 0; l < scene.n; ++l)
+    for (int k = 0; k < scene.m; ++k) {
+      for (int c = 0; c < 3; ++c)
+        EXPECT_EQ(one.positions()(k, l)[c], three.positions()(k, l)[c]) << k << ", " << l;
+      moved = std::max(moved, norm(one.positions()(k, l) - start.positions()(k, l)));
+    }
+  EXPECT_GT(moved, 1e-3);
 }
 
 // Without ksp and pc the baseline takes cg with hypre's BoomerAMG only where block Jacobi
