@@ -8,7 +8,7 @@
 # flag preset and the 120 x 120 silk crumple (scenes/hard/). For each run: exit status, the time
 # it stopped and the stability monitor's message, wall time, the step, and the sheet's quality
 # over its frames (tools/sheet_quality.py: smallest det a/det A, smallest adjacent-normal cosine,
-# self-proximity, area ratio). Writes benchmarks/results/hard-cases-<host>-<date>.{md,csv} and,
+# self-proximity, triangles passing through each other, area ratio). Writes benchmarks/results/hard-cases-<host>-<date>.{md,csv} and,
 # in a full run, one picture per scenes/hard scene from its energy-form run
 # (…-<scene>.png). Two runs at a time, each under a timeout.
 #   benchmarks/run_hard_cases.sh [--quick]
@@ -136,7 +136,8 @@ def g(r, k, fmt):
     return "—" if v is None else format(v, fmt)
 cols = ["case", "discretisation or model", "exit", "finished", "stopped at t (s)", "dt (s)", "steps",
         "wall (s)", "min det a/A", "min signed det a/A", "most inverted cells", "min normal cos",
-        "most pairs < h/2", "min far distance / h", "area ratio (summary, end)",
+        "most pairs < h/2", "min far distance / h", "most crossing triangle pairs (cells)",
+        "area ratio (summary, end)",
         "area ratio min..max (frames)", "message"]
 table = []
 for r in rows:
@@ -146,7 +147,9 @@ for r in rows:
                   format(r["wall_s"], ".1f"), g(r, "min_det_ratio", ".3g"),
                   g(r, "min_signed_det_ratio", ".3g"), g(r, "inverted_cells", "d"),
                   g(r, "min_normal_cos", ".3f"), g(r, "close_pairs", "d"),
-                  g(r, "min_far_distance_over_h", ".3f"), g(r, "summary_area_ratio", ".4f"),
+                  g(r, "min_far_distance_over_h", ".3f"),
+                  f"{g(r, 'crossing_pairs', 'd')} ({g(r, 'crossing_cells', 'd')})",
+                  g(r, "summary_area_ratio", ".4f"),
                   (f"{q['area_ratio']:.3f}..{q['max_area_ratio']:.3f}" if q else "—"),
                   r["message"].replace("|", "/")])
 with open(stem + ".csv", "w", newline="") as f:
@@ -160,7 +163,9 @@ lines = [f"# Hard cases: the flux, nodal energy and energy discretisations and m
          "Quality measures are over the frames written (100 a run, plus the last good state of a "
          "run stopped by the monitor): tools/sheet_quality.py. \"min far distance / h\": "
          "the smallest distance of two nodes more than 3 indices apart, where one is within h; "
-         "\"most pairs < h/2\": the most such pairs closer than h/2 in one frame. Exit 3: the "
+         "\"most pairs < h/2\": the most such pairs closer than h/2 in one frame; "
+         "\"most crossing triangle pairs\": the most pairs of the sheet's triangles that pass "
+         "through each other in one frame (an exact test), with the cells they lie in. Exit 3: the "
          "stability monitor stopped the run (message). Wall time includes writing frames.", "",
          "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
 lines += ["| " + " | ".join(t) + " |" for t in table]

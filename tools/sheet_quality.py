@@ -18,6 +18,12 @@ Per frame, from /positions [frames, m, n, 3] (node [k, l] at [f, k, l, :], docs/
               smallest distance / h of such far-apart pairs within h (none within h: blank).
               Found with a uniform grid of bins of size h (numpy), so a 120 x 120 sheet over a
               hundred frames takes seconds.
+  crossed     pairs of the sheet's triangles (area()'s two a cell, pairs sharing a node left
+              out) that pass through each other, by an exact test: in general position two
+              triangles intersect when an edge of one passes through the other, decided by
+              the signs of tetrahedron volumes (orient), touching not counted; coplanar
+              overlaps are not counted. Also the cells those triangles lie in ("crossing
+              cells" in --json). 0 for a sheet that never passes through itself.
   area ratio  S / S0, S the sum over cells of the two triangles (k,l)(k+1,l)(k,l+1) and
               (k+1,l+1)(k,l+1)(k+1,l).
   zig-zag     the grid-scale crinkle: along each grid line the second differences
@@ -111,6 +117,89 @@ def proximity(r, h):
     return count, ratio
 
 
+def orient(a, b, c, d):
+    """Six times the signed volume of the tetrahedra (a, b, c, d), over the leading axis."""
+    return np.einsum("...i,...i", np.cross(b - a, c - a), d - a)
+
+
+def segments_cross(p, q, a, b, c):
+    """Whether segment pq passes through the inside of triangle abc: its ends on either side
+    of the triangle's plane, and the line pq on the same side of each of the triangle's three
+    edges. Touching (a zero volume) does not count."""
+    s1, s2 = orient(a, b, c, p), orient(a, b, c, q)
+    e1, e2, e3 = orient(p, q, a, b), orient(p, q, b, c), orient(p, q, c, a)
+    return (s1 * s2 < 0) & (((e1 > 0) & (e2 > 0) & (e3 > 0)) | ((e1 < 0) & (e2 < 0) & (e3 < 0)))
+
+
+def crossings(r):
+    """(pairs of triangles that pass through each other, cells those triangles lie in) of one
+    frame. The triangles are area()'s two a cell; pairs sharing a node are left out. Two
+    triangles in general position intersect exactly when an edge of one passes through the
+    other (segments_cross, on all six edges); coplanar overlaps are not counted. Candidates:
+    triangles in neighbouring bins of a uniform grid over their centroids, each bin twice the
+    largest distance from a centroid to its corners among all but the largest 1 % of the
+    triangles, whose pairs are found with every triangle; then the boxes' overlap."""
+    m, n, _ = r.shape
+    idx = np.arange(m * n).reshape(m, n)
+    corners = np.concatenate([
+        np.stack([idx[:-1, :-1], idx[1:, :-1], idx[:-1, 1:]], axis=-1).reshape(-1, 3),
+        np.stack([idx[1:, 1:], idx[:-1, 1:], idx[1:, :-1]], axis=-1).reshape(-1, 3)])
+    cells = np.concatenate([np.arange((m - 1) * (n - 1))] * 2)
+    tri = r.reshape(-1, 3)[corners]  # [T, 3 corners, 3]
+    count = len(tri)
+    centre = tri.mean(axis=1)
+    reach = np.linalg.norm(tri - centre[:, None, :], axis=-1).max(axis=1)
+    size = max(2.0 * float(np.quantile(reach, 0.99)), 1e-300)
+    large = reach > 0.5 * size
+    low, high = tri.min(axis=1), tri.max(axis=1)
+    found = []
+
+    def test(i, j):
+        """Keeps the pairs (i, j) that share no node, whose boxes overlap and that cross."""
+        for c in range(0, i.size, 1 << 20):
+            a_i, a_j = i[c:c + (1 << 20)], j[c:c + (1 << 20)]
+            keep = ~(corners[a_i][:, :, None] == corners[a_j][:, None, :]).any(axis=(1, 2))
+            keep &= ((low[a_i] <= high[a_j]) & (low[a_j] <= high[a_i])).all(axis=1)
+            a_i, a_j = a_i[keep], a_j[keep]
+            if a_i.size == 0:
+                continue
+            a, b = tri[a_i], tri[a_j]
+            hit = np.zeros(a_i.size, dtype=bool)
+            for e in range(3):
+                hit |= segments_cross(a[:, e], a[:, (e + 1) % 3], b[:, 0], b[:, 1], b[:, 2])
+                hit |= segments_cross(b[:, e], b[:, (e + 1) % 3], a[:, 0], a[:, 1], a[:, 2])
+            if hit.any():
+                found.append(np.stack([a_i[hit], a_j[hit]], axis=1))
+
+    small = np.flatnonzero(~large)
+    bins = np.floor((centre[small] - centre[small].min(axis=0)) / size).astype(np.int64)
+    dims = bins.max(axis=0) + 3
+    key = ((bins[:, 0] + 1) * dims[1] + (bins[:, 1] + 1)) * dims[2] + (bins[:, 2] + 1)
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dz in (-1, 0, 1):
+                target = key + (dx * dims[1] + dy) * dims[2] + dz
+                lo = np.searchsorted(skey, target, "left")
+                sizes = np.searchsorted(skey, target, "right") - lo
+                total = int(sizes.sum())
+                if total == 0:
+                    continue
+                i = np.repeat(np.arange(small.size), sizes)
+                j = order[np.arange(total) + np.repeat(lo - np.cumsum(sizes) + sizes, sizes)]
+                keep = i < j
+                test(small[i[keep]], small[j[keep]])
+    everything = np.arange(count)
+    for t in np.flatnonzero(large):
+        others = everything[~large | (everything > t)]
+        test(np.full(others.size, t), others)
+    if not found:
+        return 0, 0
+    pairs = np.concatenate(found)
+    return len(pairs), len(np.unique(cells[pairs]))
+
+
 def zigzag(r):
     """(largest grid-scale amplitude in metres, grid-scale share of the curvature) of one frame,
     both grid directions together; (0, None) on a sheet too small or too flat to say."""
@@ -165,6 +254,7 @@ def analyse(path, every=1):
             finite = bool(np.isfinite(r).all())
             zz_amp, zz_frac = zigzag(r) if finite else (None, None)
             pairs, dmin = proximity(r, h) if finite else (None, None)
+            crossed, crossed_cells = crossings(r) if finite else (None, None)
             out.append({
                 "frame": fi, "step": int(steps[fi]), "time": float(times[fi]),
                 "min_det_ratio": float(ratio.min()),
@@ -172,6 +262,7 @@ def analyse(path, every=1):
                 "inverted_cells": int((sign < 0).sum()),
                 "min_normal_cos": min_cos,
                 "close_pairs": pairs, "min_far_distance_over_h": dmin,
+                "crossing_pairs": crossed, "crossing_cells": crossed_cells,
                 "area_ratio": area(r) / area0,
                 "zigzag_amplitude": zz_amp, "zigzag_fraction": zz_frac,
             })
@@ -189,6 +280,7 @@ def analyse(path, every=1):
     overall = {"status": status, "frames": len(out)}
     for key, fn in (("min_det_ratio", min), ("min_signed_det_ratio", min),
                     ("inverted_cells", max), ("min_normal_cos", min), ("close_pairs", max),
+                    ("crossing_pairs", max), ("crossing_cells", max),
                     ("min_far_distance_over_h", min), ("area_ratio", min),
                     ("zigzag_amplitude", max), ("zigzag_fraction", max)):
         v, t = extreme(key, fn)
@@ -218,18 +310,22 @@ def main():
     print(f"{res['file']}: grid {res['grid'][0]} x {res['grid'][1]}, h = {res['h']:.4g} m, "
           f"status {res['overall']['status'] or '?'}")
     print(f"{'frame':>5} {'time':>8} {'det a/A':>9} {'signed':>9} {'inv':>4} {'min cos':>8} "
-          f"{'pairs<h/2':>9} {'dmin/h':>7} {'S/S0':>7} {'zz amp':>8} {'zz frac':>7}")
+          f"{'pairs<h/2':>9} {'dmin/h':>7} {'crossed':>7} {'S/S0':>7} {'zz amp':>8} "
+          f"{'zz frac':>7}")
     for fr in res["frames"]:
         print(f"{fr['frame']:5d} {fr['time']:8.3f} {fr['min_det_ratio']:9.3g} "
               f"{fr['min_signed_det_ratio']:9.3g} {fr['inverted_cells']:4d} "
               f"{fr['min_normal_cos']:8.3f} {fmt(fr['close_pairs'], '9d')} "
-              f"{fmt(fr['min_far_distance_over_h'], '7.3f')} {fr['area_ratio']:7.4f} "
+              f"{fmt(fr['min_far_distance_over_h'], '7.3f')} {fmt(fr['crossing_pairs'], '7d')} "
+              f"{fr['area_ratio']:7.4f} "
               f"{fmt(fr['zigzag_amplitude'], '8.2e')} {fmt(fr['zigzag_fraction'], '7.3f')}")
     o = res["overall"]
     print(f"overall: det a/A {o['min_det_ratio']:.3g} (t {o['min_det_ratio_time']:.3f}), signed "
           f"{o['min_signed_det_ratio']:.3g}, most inverted cells {o['inverted_cells']}, min cos "
           f"{o['min_normal_cos']:.3f} (t {o['min_normal_cos_time']:.3f}), most pairs<h/2 "
           f"{fmt(o['close_pairs'], 'd')}, dmin/h {fmt(o['min_far_distance_over_h'], '.3f')}, "
+          f"most crossing triangle pairs {fmt(o['crossing_pairs'], 'd')} (in "
+          f"{fmt(o['crossing_cells'], 'd')} cells), "
           f"S/S0 {o['area_ratio']:.4f}..{o['max_area_ratio']:.4f} (final "
           f"{o['final_area_ratio']:.4f}), zig-zag amplitude up to "
           f"{fmt(o['zigzag_amplitude'], '.2e')} m, share up to {fmt(o['zigzag_fraction'], '.3f')}")

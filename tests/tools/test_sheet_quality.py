@@ -1,5 +1,6 @@
 """tools/sheet_quality.py's zig-zag measure tells a fold the grid resolves from a crinkle at the
-grid's own scale, on sheets made here."""
+grid's own scale, and its crossing count tells a sheet folded onto itself from one passing
+through itself, on sheets made here."""
 
 import os
 import sys
@@ -48,6 +49,48 @@ class ZigZag(unittest.TestCase):
         amplitude, share = sheet_quality.zigzag(sheet(20, 20, lambda k, l: 1.0 + noise[k, l]))
         self.assertLess(amplitude, 1e-15)
         self.assertIsNone(share)
+
+
+
+def folded(m, n, gap):
+    """A sheet folded in two along l = n // 2: the second half lies `gap` above the first,
+    turned back over it (a U), through it where the gap goes negative."""
+    k, l = np.meshgrid(np.arange(m), np.arange(n), indexing="ij")
+    half = n // 2
+    r = np.zeros((m, n, 3))
+    r[..., 0] = k * 0.1
+    r[..., 2] = np.where(l <= half, l, 2 * half - l) * 0.1
+    r[..., 1] = np.where(l <= half, 0.0, gap(l - half))
+    return r
+
+
+class Crossings(unittest.TestCase):
+    def test_a_sheet_folded_onto_itself_does_not_cross(self):
+        # The layers 5 mm apart, then the whole turned and moved: still no crossing.
+        r = folded(21, 21, lambda d: 0.005 + 0.0 * d)
+        self.assertEqual(sheet_quality.crossings(r), (0, 0))
+        c, s = np.cos(0.7), np.sin(0.7)
+        turned = r @ np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) + [3.0, -1.0, 2.0]
+        self.assertEqual(sheet_quality.crossings(turned), (0, 0))
+
+    def test_a_fold_through_itself_crosses_along_a_line(self):
+        # The upper half slants down through the lower one: they cross along a line across
+        # the sheet, inside one cell of each layer in every column of cells (0.31 keeps the
+        # line off the nodes, where touching does not count).
+        m = 21
+        r = folded(m, 21, lambda d: 0.31 - 0.06 * d)
+        pairs, cells = sheet_quality.crossings(r)
+        self.assertEqual(cells, 2 * (m - 1))
+        self.assertGreaterEqual(pairs, m - 1)
+
+    def test_a_node_thrown_through_the_sheet_is_found(self):
+        # One node of the upper layer of the U pulled 5 m down through the lower layer: its
+        # triangles are the largest of the sheet, found by the search for large triangles.
+        r = folded(21, 21, lambda d: 0.005 + 0.0 * d)
+        r[10, 15, 1] -= 5.0
+        pairs, cells = sheet_quality.crossings(r)
+        self.assertGreater(pairs, 0)
+        self.assertGreater(cells, 0)
 
 
 if __name__ == "__main__":
