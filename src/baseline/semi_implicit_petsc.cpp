@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <optional>
 #include <source_location>
 #include <stdexcept>
 #include <string>
@@ -88,6 +89,14 @@ struct SemiImplicitSolver::Impl {
   std::vector<double> rows_ahead;
   std::vector<std::uint32_t> coupled;
   std::vector<NodeHessian> row_hessians;  // one row of nodes' Hessians, the block's and its ring's
+  // Where the values go once the pattern is fixed (locate_blocks): for each owned node, each
+  // coupling and each of its three rows, the place of the block's three values in the value
+  // array of the diagonal part (from 0) or of the off-diagonal part (−1 for its first, −2 ...).
+  void locate_blocks();
+  std::vector<std::uint32_t> coupled_pattern;  // each owned node's couplings, from the first J
+  std::vector<std::int64_t> block_offsets;      // empty: MatSetValuesBlockedStencil
+  bool located = false;
+  Mat diagonal_part = nullptr, off_diagonal_part = nullptr;
 
   const Block* block;
   Dynamics* dynamics;
@@ -295,11 +304,35 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   const std::size_t width = static_cast<std::size_t>(bl.owned_k());
   rows_ahead.assign(3 * width * kCouplings * 9, 0.0);
   coupled.assign(3 * width, 0u);
+  coupled_pattern.resize(width * static_cast<std::size_t>(bl.owned_l()));
   // Row q of nodes into the matrix: each owned node's row, over the neighbours it couples to.
+  PetscScalar* diagonal_values = nullptr;
+  PetscScalar* off_diagonal_values = nullptr;
+  if (!block_offsets.empty()) {
+    check(MatSeqAIJGetArray(diagonal_part, &diagonal_values));
+    if (off_diagonal_part != nullptr) check(MatSeqAIJGetArray(off_diagonal_part, &off_diagonal_values));
+  }
   const auto flush = [&](int q) {
     const std::size_t ring = static_cast<std::size_t>(q % 3) * width;
     for (int k = bl.k0; k < bl.k1; ++k) {
       const std::size_t node = ring + static_cast<std::size_t>(k - bl.k0);
+      if (diagonal_values != nullptr) {
+        const std::size_t owned =
+            static_cast<std::size_t>(q - bl.l0) * width + static_cast<std::size_t>(k - bl.k0);
+        const std::int64_t* offsets = &block_offsets[owned * kCouplings * 3];
+        for (int c = 0; c < kCouplings; ++c) {
+          if (!(coupled[node] & (1u << c))) continue;
+          const double* block_values = &rows_ahead[(node * kCouplings + c) * 9];
+          for (int i = 0; i < 3; ++i) {
+            const std::int64_t at = offsets[3 * c + i];
+            PetscScalar* out = at >= 0 ? diagonal_values + at : off_diagonal_values + (-at - 1);
+            std::copy_n(block_values + 3 * i, 3, out);
+          }
+        }
+        std::fill_n(&rows_ahead[node * kCouplings * 9], kCouplings * 9, 0.0);
+        coupled[node] = 0u;
+        continue;
+      }
       const MatStencil row{0, q, k, 0};
       MatStencil columns[kCouplings];
       PetscScalar values[9 * kCouplings];
@@ -312,6 +345,8 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
           if (coupled[node] & (1u << c))
             for (int j = 0; j < 3; ++j) values[v++] = rows_ahead[(node * kCouplings + c) * 9 + 3 * i + j];
       check(MatSetValuesBlockedStencil(jacobian, 1, &row, count, columns, values, INSERT_VALUES));
+      coupled_pattern[static_cast<std::size_t>(q - bl.l0) * width +
+                      static_cast<std::size_t>(k - bl.k0)] = coupled[node];
       std::fill_n(&rows_ahead[node * kCouplings * 9], kCouplings * 9, 0.0);
       coupled[node] = 0u;
     }
@@ -347,8 +382,92 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
     for (; next < std::min(l, bl.l1); ++next) flush(next);
   }
   for (; next < bl.l1; ++next) flush(next);
+  if (diagonal_values != nullptr) {
+    check(MatSeqAIJRestoreArray(diagonal_part, &diagonal_values));
+    if (off_diagonal_part != nullptr)
+      check(MatSeqAIJRestoreArray(off_diagonal_part, &off_diagonal_values));
+  }
+  // Also after the direct writes: the assembly marks the matrix changed (its state) for what
+  // reads it.
   check(MatAssemblyBegin(jacobian, MAT_FINAL_ASSEMBLY));
   check(MatAssemblyEnd(jacobian, MAT_FINAL_ASSEMBLY));
+  if (!located) locate_blocks();
+}
+
+// After the first assembly the pattern is fixed: each owned node's row of each block it couples
+// to (coupled_pattern) is three consecutive values of a row of the diagonal part (columns of
+// owned nodes) or of the off-diagonal part (the others), both sequential AIJ matrices whose
+// columns are sorted. Writing there costs 0.2 µs a node where MatSetValuesBlockedStencil cost
+// 2.4 (120², one thread, docs/semi-implicit.md). A matrix of another type, or a block not found
+// where it should be, keeps MatSetValuesBlockedStencil.
+void SemiImplicitSolver::Impl::locate_blocks() {
+  const Block& bl = *block;
+  located = true;
+  PetscBool sequential = PETSC_FALSE, distributed = PETSC_FALSE;
+  check(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(jacobian), MATSEQAIJ, &sequential));
+  check(PetscObjectTypeCompare(reinterpret_cast<PetscObject>(jacobian), MATMPIAIJ, &distributed));
+  const PetscInt* columns_off = nullptr;  // the off-diagonal part's global columns, ascending
+  if (sequential) {
+    diagonal_part = jacobian;
+    off_diagonal_part = nullptr;
+  } else if (distributed) {
+    check(MatMPIAIJGetSeqAIJ(jacobian, &diagonal_part, &off_diagonal_part, &columns_off));
+  } else {
+    return;
+  }
+  PetscInt first_column, end_column, off_count = 0;
+  check(MatGetOwnershipRangeColumn(jacobian, &first_column, &end_column));
+  if (off_diagonal_part != nullptr) check(MatGetSize(off_diagonal_part, nullptr, &off_count));
+  ISLocalToGlobalMapping to_global;
+  check(DMGetLocalToGlobalMapping(da, &to_global));
+  PetscInt gxs, gys, gxm;
+  check(DMDAGetGhostCorners(da, &gxs, &gys, nullptr, &gxm, nullptr, nullptr));
+  const PetscInt *ia, *ja, *ib = nullptr, *jb = nullptr;
+  PetscInt rows;
+  PetscBool done;
+  check(MatGetRowIJ(diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done));
+  if (off_diagonal_part != nullptr)
+    check(MatGetRowIJ(off_diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ib, &jb, &done));
+  std::vector<std::int64_t> offsets(coupled_pattern.size() * kCouplings * 3, 0);
+  bool found_all = true;
+  // The place of column `column` in row `row` of a part, if there with the next two.
+  const auto place = [](const PetscInt* i, const PetscInt* j, PetscInt row, PetscInt column) {
+    const PetscInt* end = j + i[row + 1];
+    const PetscInt* at = std::lower_bound(j + i[row], end, column);
+    return end - at >= 3 && at[0] == column && at[1] == column + 1 && at[2] == column + 2
+               ? std::optional<std::int64_t>(at - j)
+               : std::nullopt;
+  };
+  for (int l = bl.l0; l < bl.l1 && found_all; ++l)
+    for (int k = bl.k0; k < bl.k1 && found_all; ++k) {
+      const std::size_t owned = static_cast<std::size_t>(l - bl.l0) * bl.owned_k() + (k - bl.k0);
+      for (int c = 0; c < kCouplings && found_all; ++c) {
+        if (!(coupled_pattern[owned] & (1u << c))) continue;
+        const PetscInt local = (l + c / 5 - 2 - gys) * gxm + (k + c % 5 - 2 - gxs);
+        PetscInt global;
+        check(ISLocalToGlobalMappingApplyBlock(to_global, 1, &local, &global));
+        const PetscInt column = 3 * global;
+        for (int i = 0; i < 3 && found_all; ++i) {
+          const auto row = static_cast<PetscInt>(3 * owned + i);
+          std::optional<std::int64_t> at;
+          if (column >= first_column && column < end_column) {
+            at = place(ia, ja, row, column - first_column);
+          } else if (off_diagonal_part != nullptr) {
+            const PetscInt* compressed =
+                std::lower_bound(columns_off, columns_off + off_count, column);
+            if (compressed != columns_off + off_count && *compressed == column)
+              if (const auto in_row = place(ib, jb, row, compressed - columns_off))
+                at = -*in_row - 1;
+          }
+          found_all = at.has_value();
+          if (found_all) offsets[(owned * kCouplings + c) * 3 + i] = *at;
+        }
+      }
+    }
+  check(MatRestoreRowIJ(diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done));
+  if (off_diagonal_part != nullptr)
+    check(MatRestoreRowIJ(off_diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ib, &jb, &done));
+  if (found_all) block_offsets = std::move(offsets);
 }
 
 void SemiImplicitSolver::linearise(const Field<Vec3>& r) {
