@@ -293,10 +293,11 @@ SemiImplicitSolver::~SemiImplicitSolver() = default;
 // Each node p's Hessian adds into the rows of the owned nodes of its box, so a block takes the
 // p of its owned nodes and of the ring around them (their E_p read two nodes out: the ghosts),
 // over the slots each E_p reads. The p are taken row by row, and an owned row of nodes, whole
-// once the p of the row above it are in, goes into the matrix then, each node's row in one
-// call: inserted block by block as each p came, the insertion cost as much as the Hessians
-// (5.6 µs a node on 120², docs/semi-implicit.md). Every entry sums its p from zero in the order
-// of the p, row by row, on any decomposition and any threads: the matrix has the same bits.
+// once the p of the row above it are in, goes into the matrix then, each node's row at once
+// (locate_blocks): inserted block by block as each p came, the insertion cost as much as the
+// Hessians (5.6 µs a node on 120², docs/semi-implicit.md). Every entry sums its p from zero in
+// the order of the p, row by row, on any decomposition and any threads: the matrix has the
+// same bits.
 void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   const Block& bl = *block;
   const ForceModel& model = dynamics->model();
@@ -397,7 +398,7 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
 // After the first assembly the pattern is fixed: each owned node's row of each block it couples
 // to (coupled_pattern) is three consecutive values of a row of the diagonal part (columns of
 // owned nodes) or of the off-diagonal part (the others), both sequential AIJ matrices whose
-// columns are sorted. Writing there costs 0.2 µs a node where MatSetValuesBlockedStencil cost
+// columns are sorted. Writing there costs 0.5 µs a node where MatSetValuesBlockedStencil cost
 // 2.4 (120², one thread, docs/semi-implicit.md). A matrix of another type, or a block not found
 // where it should be, keeps MatSetValuesBlockedStencil.
 void SemiImplicitSolver::Impl::locate_blocks() {
