@@ -306,13 +306,14 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   rows_ahead.assign(3 * width * kCouplings * 9, 0.0);
   coupled.assign(3 * width, 0u);
   coupled_pattern.resize(width * static_cast<std::size_t>(bl.owned_l()));
-  // Row q of nodes into the matrix: each owned node's row, over the neighbours it couples to.
   PetscScalar* diagonal_values = nullptr;
   PetscScalar* off_diagonal_values = nullptr;
   if (!block_offsets.empty()) {
     check(MatSeqAIJGetArray(diagonal_part, &diagonal_values));
-    if (off_diagonal_part != nullptr) check(MatSeqAIJGetArray(off_diagonal_part, &off_diagonal_values));
+    if (off_diagonal_part != nullptr)
+      check(MatSeqAIJGetArray(off_diagonal_part, &off_diagonal_values));
   }
+  // Row q of nodes into the matrix: each owned node's row, over the neighbours it couples to.
   const auto flush = [&](int q) {
     const std::size_t ring = static_cast<std::size_t>(q % 3) * width;
     for (int k = bl.k0; k < bl.k1; ++k) {
@@ -344,7 +345,8 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
       for (int i = 0; i < 3; ++i)
         for (int c = 0; c < kCouplings; ++c)
           if (coupled[node] & (1u << c))
-            for (int j = 0; j < 3; ++j) values[v++] = rows_ahead[(node * kCouplings + c) * 9 + 3 * i + j];
+            for (int j = 0; j < 3; ++j)
+              values[v++] = rows_ahead[(node * kCouplings + c) * 9 + 3 * i + j];
       check(MatSetValuesBlockedStencil(jacobian, 1, &row, count, columns, values, INSERT_VALUES));
       coupled_pattern[static_cast<std::size_t>(q - bl.l0) * width +
                       static_cast<std::size_t>(k - bl.k0)] = coupled[node];
@@ -372,7 +374,8 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
           // The column's place among the 5 × 5 nodes around the row's.
           const int c = (b / 3 - a / 3 + 2) * 5 + (b % 3 - a % 3 + 2);
           coupled[node] |= 1u << c;
-          double* block_values = &rows_ahead[(node * kCouplings + static_cast<std::size_t>(c)) * 9];
+          double* block_values =
+              &rows_ahead[(node * kCouplings + static_cast<std::size_t>(c)) * 9];
           for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j)
               block_values[3 * i + j] +=
@@ -426,11 +429,12 @@ void SemiImplicitSolver::Impl::locate_blocks() {
   const PetscInt *ia, *ja, *ib = nullptr, *jb = nullptr;
   PetscInt rows;
   PetscBool done;
+  PetscBool done_off = PETSC_TRUE;
   check(MatGetRowIJ(diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done));
   if (off_diagonal_part != nullptr)
-    check(MatGetRowIJ(off_diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ib, &jb, &done));
+    check(MatGetRowIJ(off_diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ib, &jb, &done_off));
   std::vector<std::int64_t> offsets(coupled_pattern.size() * kCouplings * 3, 0);
-  bool found_all = true;
+  bool found_all = done && done_off;
   // The place of column `column` in row `row` of a part, if there with the next two.
   const auto place = [](const PetscInt* i, const PetscInt* j, PetscInt row, PetscInt column) {
     const PetscInt* end = j + i[row + 1];
@@ -441,7 +445,7 @@ void SemiImplicitSolver::Impl::locate_blocks() {
   };
   for (int l = bl.l0; l < bl.l1 && found_all; ++l)
     for (int k = bl.k0; k < bl.k1 && found_all; ++k) {
-      const std::size_t owned = static_cast<std::size_t>(l - bl.l0) * bl.owned_k() + (k - bl.k0);
+      const auto owned = static_cast<std::size_t>((l - bl.l0) * bl.owned_k() + (k - bl.k0));
       for (int c = 0; c < kCouplings && found_all; ++c) {
         if (!(coupled_pattern[owned] & (1u << c))) continue;
         const PetscInt local = (l + c / 5 - 2 - gys) * gxm + (k + c % 5 - 2 - gxs);
@@ -465,9 +469,11 @@ void SemiImplicitSolver::Impl::locate_blocks() {
         }
       }
     }
-  check(MatRestoreRowIJ(diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done));
-  if (off_diagonal_part != nullptr)
-    check(MatRestoreRowIJ(off_diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ib, &jb, &done));
+  if (done)
+    check(MatRestoreRowIJ(diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ia, &ja, &done));
+  if (off_diagonal_part != nullptr && done_off)
+    check(MatRestoreRowIJ(off_diagonal_part, 0, PETSC_FALSE, PETSC_FALSE, &rows, &ib, &jb,
+                          &done_off));
   if (found_all) block_offsets = std::move(offsets);
 }
 
