@@ -186,6 +186,7 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded>
 // interior node's E_p is its bending terms, the stretch of its two forward edges and the cell
 // (k+½, l+½), all of weight 1; it reads the same six nodes. The coefficients are
 // trapezoidal_coefficients' (cosserat_energy.cpp), and trapezoidal_energy is the general form.
+// V is Vec3 for the force, or the DualVec3 of CosseratEnergy::interior_hessian.
 template <bool Bending, bool Coupling, bool Normal, bool Bounded, class V>
 [[gnu::always_inline]] inline BasicInteriorGradient<V> trapezoidal_gradient(
     const InteriorCoefficients& c, const V& r, const V& r_right, const V& r_left, const V& r_up,
@@ -204,9 +205,9 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded, class V>
   if (Bending || Normal) {
     const V left = r_left - r, down = r_down - r;
     const BasicUnit<V> q0 = corner<Bounded>(right, up, c.corner, crushed),
-               q1 = corner<Bounded>(up, left, c.corner, crushed),
-               q2 = corner<Bounded>(left, down, c.corner, crushed),
-               q3 = corner<Bounded>(down, right, c.corner, crushed);
+                       q1 = corner<Bounded>(up, left, c.corner, crushed),
+                       q2 = corner<Bounded>(left, down, c.corner, crushed),
+                       q3 = corner<Bounded>(down, right, c.corner, crushed);
     const BasicUnit<V> sum =
         bounded_unit<Bounded>(((q0.unit + q1.unit) + q2.unit) + q3.unit, c.sum, crushed);
     const V n = sum.unit;
@@ -236,9 +237,9 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded, class V>
       const V G_n = mu11 * d11 + mu22 * d22;
       const V G_s = unit_gradient(sum, G_n);
       const BasicCornerGradient<V> g0 = corner_gradient(q0, right, up, G_s),
-                           g1 = corner_gradient(q1, up, left, G_s),
-                           g2 = corner_gradient(q2, left, down, G_s),
-                           g3 = corner_gradient(q3, down, right, G_s);
+                                   g1 = corner_gradient(q1, up, left, G_s),
+                                   g2 = corner_gradient(q2, left, down, G_s),
+                                   g3 = corner_gradient(q3, down, right, G_s);
       g_right += g0.e;
       g_up += g0.f;
       g_up += g1.e;
