@@ -137,8 +137,9 @@ def crossings(r):
     triangles in general position intersect exactly when an edge of one passes through the
     other (segments_cross, on all six edges); coplanar overlaps are not counted. Candidates:
     triangles in neighbouring bins of a uniform grid over their centroids, each bin twice the
-    largest distance from a centroid to its corners among all but the largest 1 % of the
-    triangles, whose pairs are found with every triangle; then the boxes' overlap."""
+    largest distance from a centroid to its corners among the triangles within four times the
+    median of that distance; the others, stretched far (a sheet blowing up), are paired with
+    every triangle; then the boxes' overlap."""
     m, n, _ = r.shape
     idx = np.arange(m * n).reshape(m, n)
     corners = np.concatenate([
@@ -149,8 +150,9 @@ def crossings(r):
     count = len(tri)
     centre = tri.mean(axis=1)
     reach = np.linalg.norm(tri - centre[:, None, :], axis=-1).max(axis=1)
-    size = max(2.0 * float(np.quantile(reach, 0.99)), 1e-300)
-    large = reach > 0.5 * size
+    typical = reach <= 4.0 * float(np.median(reach))
+    size = max(2.0 * float(reach[typical].max()), 1e-300)
+    large = ~typical
     low, high = tri.min(axis=1), tri.max(axis=1)
     found = []
 
