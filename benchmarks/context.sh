@@ -9,6 +9,7 @@ if [ "${CONTEXT_BUILD:-1}" != 0 ]; then
   cmake --build --preset "$2" --target "$3" -j "$(nproc)" >/dev/null
 fi
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+preset=$2
 date=$(date -u +%Y-%m-%d)
 host=$(hostname -s)
 stem=benchmarks/results/$1-$host-$date
@@ -28,7 +29,7 @@ run_step_benchmark() {
   OMP_PROC_BIND=close "$binary" --benchmark_min_time=2 --benchmark_repetitions=3 \
     --benchmark_report_aggregates_only=true \
     --benchmark_context=cpu="$cpu" --benchmark_context=compiler="$compiler" \
-    --benchmark_context=preset=benchmark --benchmark_context=git="$revision" \
+    --benchmark_context=preset="$preset" --benchmark_context=git="$revision" \
     --benchmark_context=ranks=1 \
     --benchmark_out="$stem.json" --benchmark_out_format=json "$@"
 }

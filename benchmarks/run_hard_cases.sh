@@ -8,9 +8,9 @@
 # flag preset and the 120 x 120 silk crumple (scenes/hard/). For each run: exit status, the time
 # it stopped and the stability monitor's message, wall time, the step, and the sheet's quality
 # over its frames (tools/sheet_quality.py: smallest det a/det A, smallest adjacent-normal cosine,
-# self-proximity, triangles passing through each other, area ratio). Writes benchmarks/results/hard-cases-<host>-<date>.{md,csv} and,
-# in a full run, one picture per scenes/hard scene from its energy-form run
-# (…-<scene>.png). Two runs at a time, each under a timeout.
+# self-proximity, triangles passing through each other, area ratio). Writes
+# benchmarks/results/hard-cases-<host>-<date>.{md,csv} and, in a full run, one picture per
+# scenes/hard scene from its energy-form run (…-<scene>.png). Two runs at a time, each under a timeout.
 #   benchmarks/run_hard_cases.sh [--quick]
 # --quick: every run 1/10 of its steps (a check of the script, not results; files *-quick.*).
 # COSSERAT=path: the binary to run (default build/release/cosserat, built here);

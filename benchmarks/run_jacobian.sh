@@ -2,19 +2,14 @@
 # The exact Jacobian's node Hessians per node (bench_jacobian) against one force evaluation, on
 # a bent 120² sheet, one thread, in the release preset's portable build that `cosserat` runs as,
 # into benchmarks/results/jacobian-<host>-<date>.{json,md} with the machine, compiler, git
-# revision and date. The Jacobian's whole cost, with the PETSc
-# insertion, is the run summary's "Jacobian" time (docs/semi-implicit.md, "The Jacobian").
+# revision and date. The Jacobian's whole cost, with the PETSc insertion, is the run summary's
+# "Jacobian" time (docs/semi-implicit.md, "The Jacobian").
 #   benchmarks/run_jacobian.sh [extra Google Benchmark flags]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source benchmarks/context.sh jacobian release bench_jacobian
 
-OMP_PROC_BIND=close build/release/benchmarks/bench_jacobian --benchmark_repetitions=3 \
-  --benchmark_report_aggregates_only=true \
-  --benchmark_context=cpu="$cpu" --benchmark_context=compiler="$compiler" \
-  --benchmark_context=preset=release --benchmark_context=git="$revision" \
-  --benchmark_context=ranks=1 \
-  --benchmark_out="$stem.json" --benchmark_out_format=json "$@"
+run_step_benchmark build/release/benchmarks/bench_jacobian "$@"
 
 /usr/bin/python3 - "$stem" "$cpu" "$compiler" "$revision" "$date" <<'PY'
 import json, sys

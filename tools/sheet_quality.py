@@ -81,38 +81,43 @@ def unit_normals(e1, e2):
         return np.where(norm > 0, n / np.where(norm > 0, norm, 1), 0.0)
 
 
+def bin_pairs(points, size):
+    """Index pairs (i, j) of points in the same or neighbouring bins of a uniform grid of bins
+    of `size`, as arrays, one neighbouring offset at a time (each pair twice, i = j too): every
+    two points closer than `size` are among them."""
+    cell = np.floor((points - points.min(axis=0)) / size).astype(np.int64)
+    dims = cell.max(axis=0) + 3
+    key = ((cell[:, 0] + 1) * dims[1] + (cell[:, 1] + 1)) * dims[2] + (cell[:, 2] + 1)
+    order = np.argsort(key, kind="stable")
+    skey = key[order]
+    for dx in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dz in (-1, 0, 1):
+                target = key + (dx * dims[1] + dy) * dims[2] + dz
+                lo = np.searchsorted(skey, target, "left")
+                sizes = np.searchsorted(skey, target, "right") - lo
+                total = int(sizes.sum())
+                if total == 0:
+                    continue
+                i = np.repeat(np.arange(points.shape[0]), sizes)
+                yield i, order[np.arange(total) + np.repeat(lo - np.cumsum(sizes) + sizes, sizes)]
+
+
 def proximity(r, h):
     """Pairs (i < j) with Chebyshev index distance > FAR closer than h: (count below h/2,
     smallest distance / h or None)."""
     m, n, _ = r.shape
     pts = r.reshape(-1, 3)
     kk, ll = np.divmod(np.arange(m * n), n)
-    cell = np.floor((pts - pts.min(axis=0)) / h).astype(np.int64)
-    dims = cell.max(axis=0) + 3
-    key = ((cell[:, 0] + 1) * dims[1] + (cell[:, 1] + 1)) * dims[2] + (cell[:, 2] + 1)
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
     count, best = 0, math.inf
-    for dx in (-1, 0, 1):
-        for dy in (-1, 0, 1):
-            for dz in (-1, 0, 1):
-                target = key + (dx * dims[1] + dy) * dims[2] + dz
-                lo = np.searchsorted(skey, target, "left")
-                hi = np.searchsorted(skey, target, "right")
-                sizes = hi - lo
-                total = int(sizes.sum())
-                if total == 0:
-                    continue
-                i = np.repeat(np.arange(pts.shape[0]), sizes)
-                start = np.repeat(lo - np.cumsum(sizes) + sizes, sizes)
-                j = order[np.arange(total) + start]
-                keep = (i < j) & (np.maximum(abs(kk[i] - kk[j]), abs(ll[i] - ll[j])) > FAR)
-                if not keep.any():
-                    continue
-                i, j = i[keep], j[keep]
-                d = np.linalg.norm(pts[i] - pts[j], axis=-1)
-                count += int((d < 0.5 * h).sum())
-                best = min(best, float(d.min()))
+    for i, j in bin_pairs(pts, h):
+        keep = (i < j) & (np.maximum(abs(kk[i] - kk[j]), abs(ll[i] - ll[j])) > FAR)
+        if not keep.any():
+            continue
+        i, j = i[keep], j[keep]
+        d = np.linalg.norm(pts[i] - pts[j], axis=-1)
+        count += int((d < 0.5 * h).sum())
+        best = min(best, float(d.min()))
     ratio = best / h if best < h else None
     return count, ratio
 
@@ -147,12 +152,10 @@ def crossings(r):
         np.stack([idx[1:, 1:], idx[:-1, 1:], idx[1:, :-1]], axis=-1).reshape(-1, 3)])
     cells = np.concatenate([np.arange((m - 1) * (n - 1))] * 2)
     tri = r.reshape(-1, 3)[corners]  # [T, 3 corners, 3]
-    count = len(tri)
     centre = tri.mean(axis=1)
     reach = np.linalg.norm(tri - centre[:, None, :], axis=-1).max(axis=1)
     typical = reach <= 4.0 * float(np.median(reach))
     size = max(2.0 * float(reach[typical].max()), 1e-300)
-    large = ~typical
     low, high = tri.min(axis=1), tri.max(axis=1)
     found = []
 
@@ -173,28 +176,13 @@ def crossings(r):
             if hit.any():
                 found.append(np.stack([a_i[hit], a_j[hit]], axis=1))
 
-    small = np.flatnonzero(~large)
-    bins = np.floor((centre[small] - centre[small].min(axis=0)) / size).astype(np.int64)
-    dims = bins.max(axis=0) + 3
-    key = ((bins[:, 0] + 1) * dims[1] + (bins[:, 1] + 1)) * dims[2] + (bins[:, 2] + 1)
-    order = np.argsort(key, kind="stable")
-    skey = key[order]
-    for dx in (-1, 0, 1):
-        for dy in (-1, 0, 1):
-            for dz in (-1, 0, 1):
-                target = key + (dx * dims[1] + dy) * dims[2] + dz
-                lo = np.searchsorted(skey, target, "left")
-                sizes = np.searchsorted(skey, target, "right") - lo
-                total = int(sizes.sum())
-                if total == 0:
-                    continue
-                i = np.repeat(np.arange(small.size), sizes)
-                j = order[np.arange(total) + np.repeat(lo - np.cumsum(sizes) + sizes, sizes)]
-                keep = i < j
-                test(small[i[keep]], small[j[keep]])
-    everything = np.arange(count)
-    for t in np.flatnonzero(large):
-        others = everything[~large | (everything > t)]
+    small = np.flatnonzero(typical)
+    for i, j in bin_pairs(centre[small], size):
+        keep = i < j
+        test(small[i[keep]], small[j[keep]])
+    everything = np.arange(len(tri))
+    for t in np.flatnonzero(~typical):
+        others = everything[typical | (everything > t)]
         test(np.full(others.size, t), others)
     if not found:
         return 0, 0

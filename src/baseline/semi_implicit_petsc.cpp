@@ -303,8 +303,9 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
   const ForceModel& model = dynamics->model();
   const double scale = -1.0 / model.node_mass().interior;
   const std::size_t width = static_cast<std::size_t>(bl.owned_k());
-  rows_ahead.assign(3 * width * kCouplings * 9, 0.0);
-  coupled.assign(3 * width, 0u);
+  // Zero from the first Jacobian on: each row is cleared as it goes into the matrix.
+  rows_ahead.resize(3 * width * kCouplings * 9, 0.0);
+  coupled.resize(3 * width, 0u);
   coupled_pattern.resize(width * static_cast<std::size_t>(bl.owned_l()));
   PetscScalar* diagonal_values = nullptr;
   PetscScalar* off_diagonal_values = nullptr;
@@ -318,9 +319,9 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
     const std::size_t ring = static_cast<std::size_t>(q % 3) * width;
     for (int k = bl.k0; k < bl.k1; ++k) {
       const std::size_t node = ring + static_cast<std::size_t>(k - bl.k0);
+      const std::size_t owned =
+          static_cast<std::size_t>(q - bl.l0) * width + static_cast<std::size_t>(k - bl.k0);
       if (diagonal_values != nullptr) {
-        const std::size_t owned =
-            static_cast<std::size_t>(q - bl.l0) * width + static_cast<std::size_t>(k - bl.k0);
         const std::int64_t* offsets = &block_offsets[owned * kCouplings * 3];
         for (int c = 0; c < kCouplings; ++c) {
           if (!(coupled[node] & (1u << c))) continue;
@@ -331,25 +332,23 @@ void SemiImplicitSolver::Impl::assemble_hessians(const Field<Vec3>& r) {
             std::copy_n(block_values + 3 * i, 3, out);
           }
         }
-        std::fill_n(&rows_ahead[node * kCouplings * 9], kCouplings * 9, 0.0);
-        coupled[node] = 0u;
-        continue;
-      }
-      const MatStencil row{0, q, k, 0};
-      MatStencil columns[kCouplings];
-      PetscScalar values[9 * kCouplings];
-      int count = 0;
-      for (int c = 0; c < kCouplings; ++c)
-        if (coupled[node] & (1u << c)) columns[count++] = {0, q + c / 5 - 2, k + c % 5 - 2, 0};
-      int v = 0;
-      for (int i = 0; i < 3; ++i)
+      } else {
+        const MatStencil row{0, q, k, 0};
+        MatStencil columns[kCouplings];
+        PetscScalar values[9 * kCouplings];
+        int count = 0;
         for (int c = 0; c < kCouplings; ++c)
-          if (coupled[node] & (1u << c))
-            for (int j = 0; j < 3; ++j)
-              values[v++] = rows_ahead[(node * kCouplings + c) * 9 + 3 * i + j];
-      check(MatSetValuesBlockedStencil(jacobian, 1, &row, count, columns, values, INSERT_VALUES));
-      coupled_pattern[static_cast<std::size_t>(q - bl.l0) * width +
-                      static_cast<std::size_t>(k - bl.k0)] = coupled[node];
+          if (coupled[node] & (1u << c)) columns[count++] = {0, q + c / 5 - 2, k + c % 5 - 2, 0};
+        int v = 0;
+        for (int i = 0; i < 3; ++i)
+          for (int c = 0; c < kCouplings; ++c)
+            if (coupled[node] & (1u << c))
+              for (int j = 0; j < 3; ++j)
+                values[v++] = rows_ahead[(node * kCouplings + c) * 9 + 3 * i + j];
+        check(
+            MatSetValuesBlockedStencil(jacobian, 1, &row, count, columns, values, INSERT_VALUES));
+        coupled_pattern[owned] = coupled[node];
+      }
       std::fill_n(&rows_ahead[node * kCouplings * 9], kCouplings * 9, 0.0);
       coupled[node] = 0u;
     }
