@@ -30,6 +30,7 @@ struct KesFabric {
   double shear_rigidity;      // G, gf/(cm degree)
   double extension_at_500;    // EMT, %: the strain under a tension of 500 gf/cm
   double coupling_fraction;   // φ as a fraction of its bound 2√(ζξ); no instrument measures it
+  double thickness_mm;        // typical of the fabric, not measured
 };
 
 constexpr double kGramForce = 9.80665e-3;  // N
@@ -53,7 +54,7 @@ Preset kes_fabric(const KesFabric& fabric) {
   const double curvature = bending / 6.0;
   const Sym2 xi{curvature, curvature, curvature};
   return {fabric.name, fabric.grams_per_square_metre / 1000.0, 1.0, zeta, xi,
-          coupling(zeta, xi, fabric.coupling_fraction)};
+          coupling(zeta, xi, fabric.coupling_fraction), fabric.thickness_mm * 1e-3};
 }
 
 // A fabric as H. Wang, J. F. O'Brien and R. Ramamoorthi, "Data-driven elastic models for cloth:
@@ -71,6 +72,7 @@ struct WangFabric {
   double bending_0;   // k_e of a hinge along u (bends the cloth along v), N m
   double bending_45;  // hinge at 45°
   double bending_90;  // hinge along v (bends the cloth along u)
+  double thickness_mm;  // not in the measurements: typical of the fabric's kind
 };
 
 // No instrument measures φ: the fraction of its bound the KES-F presets without a calibration
@@ -90,11 +92,12 @@ Preset wang_fabric(const WangFabric& fabric) {
   const Sym2 xi{rigidity_1 / 6.0, rigidity_45 - (rigidity_1 + rigidity_2) / 4.0,
                 rigidity_2 / 6.0};
   return {fabric.name, fabric.density, 1.0, zeta, xi,
-          coupling(zeta, xi, kWangCouplingFraction)};
+          coupling(zeta, xi, kWangCouplingFraction), fabric.thickness_mm * 1e-3};
 }
 
+// The calibrations name no fabric's thickness: they take a typical woven cloth's, 0.5 mm.
 Preset calibration(const char* name, double mass_of_10x10, double zeta, double xi, double phi) {
-  return {name, mass_of_10x10, 100.0, {zeta, zeta, zeta}, {xi, xi, xi}, {phi, phi, phi}};
+  return {name, mass_of_10x10, 100.0, {zeta, zeta, zeta}, {xi, xi, xi}, {phi, phi, phi}, 0.5e-3};
 }
 
 // φ of a calibration as a fraction of 2√(ζξ): the coupling its fabric is given at real size.
@@ -115,36 +118,36 @@ const std::vector<Preset>& material_presets() {
   // stretching table's row 0 (N/m), k_e of its bending table's column 0 at 0°, 45° and 90° (N m).
   static const std::vector<Preset> presets{
       // Typical values throughout, not measured.
-      kes_fabric({"silk", 60.0, 0.03, 0.4, 8.0, coupling_fraction(100.0, 0.01, 0.1)}),
+      kes_fabric({"silk", 60.0, 0.03, 0.4, 8.0, coupling_fraction(100.0, 0.01, 0.1), 0.1}),
       // B and weight measured; G and EMT typical values.
-      kes_fabric({"cotton", 123.8, 0.118, 1.0, 4.0, coupling_fraction(100.0, 0.02, 0.1)}),
+      kes_fabric({"cotton", 123.8, 0.118, 1.0, 4.0, coupling_fraction(100.0, 0.02, 0.1), 0.3}),
       // Typical values throughout, not measured.
-      kes_fabric({"linen", 180.0, 0.30, 1.5, 3.0, coupling_fraction(100.0, 0.04, 0.01)}),
+      kes_fabric({"linen", 180.0, 0.30, 1.5, 3.0, coupling_fraction(100.0, 0.04, 0.01), 0.4}),
       // B and weight measured; G and EMT typical values.
-      kes_fabric({"wool", 162.9, 0.067, 0.6, 5.0, 0.03}),
-      kes_fabric({"polyester", 116.5, 0.077, 0.8, 3.0, 0.03}),
+      kes_fabric({"wool", 162.9, 0.067, 0.6, 5.0, 0.03, 0.6}),
+      kes_fabric({"polyester", 116.5, 0.077, 0.8, 3.0, 0.03, 0.25}),
       // Measured (KES-F); its density is 11oz-black-denim's.
-      kes_fabric({"denim", 324.0, 0.172, 2.18, 5.515, coupling_fraction(100.0, 0.03, 0.1)}),
+      kes_fabric({"denim", 324.0, 0.172, 2.18, 5.515, coupling_fraction(100.0, 0.03, 0.1), 0.8}),
       wang_fabric({"11oz-black-denim", 0.324, 205.352, 1013.89, 53.3872, 6.41965e-05,
-                   7.33846e-05, 9.69516e-05}),
+                   7.33846e-05, 9.69516e-05, 0.8}),
       wang_fabric({"royal-target", 0.22, 2016.55, 2034.98, 104.76, 0.00012541, 0.000107998,
-                   0.00012541}),
+                   0.00012541, 0.45}),
       wang_fabric({"gray-interlock", 0.187, 16.5938, 34.4771, 36.8603, 2.31917e-05, 2.475e-05,
-                   1.42676e-05}),
+                   1.42676e-05, 0.7}),
       wang_fabric({"ivory-rib-knit", 0.276, 42.871, 65.166, 83.1756, 4.62376e-05, 3.00159e-05,
-                   3.22439e-05}),
+                   3.22439e-05, 0.9}),
       wang_fabric({"white-dots-on-blk", 0.128, 2002.09, 2027.49, 19.189, 5.17138e-05,
-                   4.06595e-05, 3.12828e-05}),
+                   4.06595e-05, 3.12828e-05, 0.25}),
       wang_fabric({"pink-ribbon-brown", 0.228, 151.504, 244.831, 30.2502, 0.00011707,
-                   8.75098e-05, 5.97743e-05}),
+                   8.75098e-05, 5.97743e-05, 0.45}),
       wang_fabric({"tango-red-jet-set", 0.113, 43.0676, 171.425, 14.3147, 1.42938e-05,
-                   2.19517e-05, 2.03457e-05}),
+                   2.19517e-05, 2.03457e-05, 0.5}),
       wang_fabric({"navy-sparkle-sweat", 0.224, 12.4863, 3.27243, 17.6163, 5.94697e-05,
-                   4.00723e-05, 4.5625e-05}),
+                   4.00723e-05, 4.5625e-05, 0.9}),
       wang_fabric({"camel-ponte-roma", 0.284, 31.1462, 44.0287, 31.8964, 3.63484e-05,
-                   3.30133e-05, 3.71576e-05}),
+                   3.30133e-05, 3.71576e-05, 1.0}),
       wang_fabric({"white-swim-solid", 0.204, 47.9712, 104.615, 60.7737, 6.02379e-05,
-                   5.88032e-05, 5.10188e-05}),
+                   5.88032e-05, 5.10188e-05, 0.6}),
       calibration("silk-10m", 78.0, 100.0, 0.01, 0.1),
       calibration("cotton-10m", 88.0, 100.0, 0.02, 0.1),
       calibration("denim-10m", 111.0, 100.0, 0.03, 0.1),

@@ -16,6 +16,9 @@ struct Material {
   Sym2 zeta{};        // metric resistance, N/m (J/m²)
   Sym2 xi{};          // curvature resistance, N m (J)
   Sym2 phi{};         // buckling factor (metric-curvature coupling), N
+  // m: how far apart self-contact keeps the cloth's layers (docs/contact.md, "Self-contact");
+  // 0 where neither the scene nor its preset gives one.
+  double thickness = 0.0;
 };
 
 // A named material (docs/materials.md): the three tensors and the mass of a sheet of `area`
@@ -29,6 +32,7 @@ struct Preset {
   Sym2 zeta;    // N/m
   Sym2 xi;      // N m
   Sym2 phi;     // N
+  double thickness;  // m, typical of the fabric, not measured (docs/materials.md)
 };
 
 const std::vector<Preset>& material_presets();
