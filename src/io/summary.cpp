@@ -90,6 +90,7 @@ RunSummary summarize_run(const Scene& scene, Simulation& simulation, const StepL
                                 std::string(solid_motion_name(contact->spec(i).motion)),
                                 contact->state(i)});
   }
+  summary.self_contact = simulation.self_contact_summary();
   return summary;
 }
 
@@ -144,6 +145,13 @@ std::string to_json(const RunSummary& s) {
       s.contact ? json_number(s.contact->max_penetration) : "null";
   const std::string max_contacts =
       s.contact ? fmt::format("{}", s.contact->max_contacts) : "null";
+  const std::string self_contact =
+      s.self_contact ? fmt::format(R"({{"max_pairs": {}, "closest": {}}})",
+                                   s.self_contact->max_pairs,
+                                   std::isfinite(s.self_contact->closest)
+                                       ? json_number(s.self_contact->closest)
+                                       : std::string("null"))
+                     : "null";
   return fmt::format(
       R"({{
   "scene": {},
@@ -175,7 +183,8 @@ std::string to_json(const RunSummary& s) {
   "adaptive": {},
   "max_penetration": {},
   "max_contacts": {},
-  "solids": {}
+  "solids": {},
+  "self_contact": {}
 }}
 )",
       json_string(s.scene), s.m, s.n, s.ranks, s.threads, fmt::join(s.thread_steps, ", "),
@@ -185,7 +194,7 @@ std::string to_json(const RunSummary& s) {
       json_number(s.halo_seconds), restarted_from, json_string(s.status), unstable_step,
       json_number(s.area_ratio), json_number(s.max_speed), json_number(s.kinetic_energy),
       json_number(s.elastic_energy), json_number(s.gravitational_energy), json_number(com.x), json_number(com.y), json_number(com.z), json_string(s.output), linear_solves, rest, adaptive,
-      max_penetration, max_contacts, solids);
+      max_penetration, max_contacts, solids, self_contact);
 }
 
 void write_summary(const std::string& path, const RunSummary& summary) {

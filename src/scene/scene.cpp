@@ -208,7 +208,9 @@ void read_particle_mass(const Table& material, Scene& scene) {
       given->fail(
           "the mass-spring model takes no Cosserat material; give mass, density or "
           "particle_mass here and the springs' ke and kd in [model]");
-  material.allow({"mass", "density", "particle_mass"});
+  material.allow({"mass", "density", "particle_mass", "thickness"});
+  if (const auto thickness = material.find("thickness"))
+    scene.material.thickness = positive(*thickness);
   const double nodes = static_cast<double>(scene.m) * scene.n;
   const auto mass = material.find("mass");
   const auto density = material.find("density");
@@ -228,7 +230,7 @@ void read_particle_mass(const Table& material, Scene& scene) {
 }
 
 void read_cosserat_material(const Table& material, Scene& scene) {
-  material.allow({"preset", "mass", "density", "zeta", "xi", "phi"});
+  material.allow({"preset", "mass", "density", "zeta", "xi", "phi", "thickness"});
   const double area = scene.size1 * scene.size2;
 
   std::optional<Preset> preset;
@@ -256,6 +258,10 @@ void read_cosserat_material(const Table& material, Scene& scene) {
   } else {
     material.missing("mass", "mass (total kg) or density (kg/m^2), exactly one (or a preset)");
   }
+  if (const auto thickness = material.find("thickness"))
+    scene.material.thickness = positive(*thickness);
+  else if (preset)
+    scene.material.thickness = preset->thickness;
   if (preset) warn_of_overridden_preset(material, *preset_entry, scene);
 }
 
@@ -944,10 +950,32 @@ void warn_if_folds_unresolved(const Origin& origin, Scene& scene) {
       origin.path(), fmt::join(short_axes, " and "), kSmooth));
 }
 
+// docs/contact.md, "Self-contact": the layers are kept the material's thickness apart, which
+// must be less than a grid spacing: a node is exempt only from the cells within two grid steps
+// of it, and the nearest others lie about two spacings away in a flat sheet.
+SelfContactSpec read_self_contact(const Table& table, const Scene& scene) {
+  table.allow({"friction"});
+  SelfContactSpec spec;
+  if (const auto friction = table.find("friction")) spec.friction = non_negative(*friction);
+  spec.thickness = scene.material.thickness;
+  if (spec.thickness == 0.0)
+    table.fail(
+        "self-contact keeps the cloth's layers its thickness apart: give material.thickness "
+        "(m), or a material preset, which has one (docs/materials.md)");
+  const double spacing = std::min(scene.h1(), scene.h2());
+  if (!(spec.thickness < spacing))
+    table.fail(fmt::format(
+        "material.thickness = {} m is not less than the grid spacing {} m: self-contact needs a "
+        "cloth thinner than its grid (docs/contact.md, \"Self-contact\"); refine the grid or "
+        "give a smaller material.thickness",
+        spec.thickness, spacing));
+  return spec;
+}
+
 void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   root.allow(
       {"title", "grid", "material", "model", "environment", "time", "output", "fix", "load",
-       "solid"});
+       "solid", "self_contact"});
   if (const auto title = root.find("title")) scene.title = title->string();
   // Grid first: the material's mass and every node set depend on it.
   read_grid(root.require_table("grid", "a [grid] table with nodes and size"), scene);
@@ -974,6 +1002,8 @@ void read_scene(const Table& root, const Origin& origin, Scene& scene) {
   // Every integrator takes solids, the semi-implicit one too: contact acts on each accepted
   // step, after the scheme, whatever the scheme.
   if (const auto solids = root.find("solid")) scene.solids = read_solids(*solids, scene);
+  if (const auto self = root.find_table("self_contact"))
+    scene.self_contact = read_self_contact(*self, scene);
   if (scene.model_kind == ModelKind::cosserat) {
     warn_if_not_positive_definite(origin, scene);
     warn_if_folds_unresolved(origin, scene);

@@ -128,6 +128,47 @@ class Simulation::ContactAction final : public StepAction, public RowReader {
   ContactSummary summary_;
 };
 
+// docs/contact.md, "Self-contact": the cloth against its own cells on every proposed step,
+// before the solids, which have the last word on where nodes go.
+class Simulation::SelfContactAction final : public StepAction {
+ public:
+  SelfContactAction(SelfContact& self, const Constraints& constraints, const Block& block)
+      : self_(&self), constraints_(&constraints), block_(&block) {}
+
+  void apply(ProposedStep& p) override {
+    const Block& b = *block_;
+    held_.assign(static_cast<std::size_t>(b.owned_k()) * static_cast<std::size_t>(b.owned_l()), 0);
+    for (const Constraints::NodeState& node : constraints_->state())
+      if (b.owns(node.k, node.l) && node.held != 0)
+        held_[static_cast<std::size_t>(node.l - b.l0) * static_cast<std::size_t>(b.owned_k()) +
+              static_cast<std::size_t>(node.k - b.k0)] = 1;
+    last_ = self_->respond(p.dt, p.positions, p.next_positions, p.next_velocities, p.starts,
+                           held_, p.velocities, p.moved_rows);
+  }
+  bool marks_moved_rows() const override { return true; }
+  void accepted() override {
+    summary_.max_pairs = std::max(summary_.max_pairs, last_.contacts);
+    summary_.closest = std::min(summary_.closest, last_.closest);
+  }
+  std::vector<double> state() const override {
+    return {static_cast<double>(summary_.max_pairs), summary_.closest};
+  }
+  void restore(const std::vector<double>& values) override {
+    if (values.size() != 2) throw std::invalid_argument("self-contact state: two numbers");
+    summary_.max_pairs = static_cast<long>(values[0]);
+    summary_.closest = values[1];
+  }
+  const SelfContactSummary& summary() const { return summary_; }
+
+ private:
+  SelfContact* self_;
+  const Constraints* constraints_;
+  const Block* block_;
+  std::vector<char> held_;
+  SelfContactStats last_;
+  SelfContactSummary summary_;
+};
+
 Simulation::Simulation(const Scene& scene, MPI_Comm comm, const SchemeFactory& make)
     : Simulation(scene, comm, Decomposition::choose(scene.m, scene.n, size_of(comm)), make) {}
 
@@ -142,11 +183,21 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
                    ? nullptr
                    : std::make_unique<Contact>(scene.solids, block_, halo_, dynamics_.node_mass(),
                                                scene.gravity, std::min(scene.h1(), scene.h2()))),
+      self_contact_(scene.self_contact
+                        ? std::make_unique<SelfContact>(scene.self_contact->thickness,
+                                                        scene.self_contact->friction, block_,
+                                                        dynamics_.node_mass(), scene.solids)
+                        : nullptr),
       stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),
                initial_velocities(scene, block_), make) {
   if (dynamics_.model().acts_on_steps())
     stepper_.add_action(
         std::make_unique<ModelAction>(dynamics_.model(), halo_, stepper_.constraints(), block_));
+  if (self_contact_) {
+    auto action = std::make_unique<SelfContactAction>(*self_contact_, stepper_.constraints(), block_);
+    self_contact_action_ = action.get();
+    stepper_.add_action(std::move(action));
+  }
   if (contact_) {
     auto action = std::make_unique<ContactAction>(*contact_);
     contact_action_ = action.get();
@@ -156,6 +207,11 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
 
 ContactSummary Simulation::contact_summary() const {
   return contact_action_ ? contact_action_->summary() : ContactSummary{};
+}
+
+std::optional<SelfContactSummary> Simulation::self_contact_summary() const {
+  if (!self_contact_action_) return std::nullopt;
+  return self_contact_action_->summary();
 }
 
 double Simulation::memory_bytes(const Block& block, Integrator integrator, const ModelSpec& model,

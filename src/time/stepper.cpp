@@ -71,7 +71,7 @@ std::optional<Instability> Stepper::step(double dt, double end_time) {
     moved_rows_.clear();
   ProposedStep proposed{step_ + 1,       dt,    scheme_->positions(), scheme_->next_positions(),
                         scheme_->next_velocities(), time_, set_velocities_,
-                        mark ? &moved_rows_ : nullptr};
+                        mark ? &moved_rows_ : nullptr, scheme_->next_starts()};
   for (const auto& action : actions_) action->apply(proposed);
   if (scheme_->has_stages() && !actions_.empty()) settle_stage_neighbours(proposed);
   if (mark)

@@ -21,6 +21,7 @@
 #include "cosserat/model/surface_measures.hpp"
 #include "cosserat/time/step_loop.hpp"
 #include "mpi_support.hpp"
+#include "support/layers.hpp"
 #include "support/sheets.hpp"
 
 namespace cosserat {
@@ -396,6 +397,43 @@ TEST(DecompositionInvariance, ContactOnOneFloorFollowsTheOneBlockRun) {
   floor.thickness = 2e-3;
   scene.solids.push_back(floor);
   expect_every_split_follows_the_one_block_run(scene);
+}
+
+// Self-contact (docs/contact.md, "Self-contact"): every rank gathers the grid's step and runs
+// the same response, so a layer fired onto another lying on a floor, with the pairs across every
+// block border, follows the one-block run bitwise on every split, in a scheme of each state kind.
+TEST(DecompositionInvariance, SelfContactFollowsTheOneBlockRun) {
+  for (const Integrator integrator : {Integrator::verlet, Integrator::velocity_verlet}) {
+    SCOPED_TRACE(integrator_name(integrator));
+    Scene scene = testing::layered_sheet(2e-3);
+    scene.integrator = integrator;
+    scene.dt = 1e-4;
+    scene.steps = 80;
+    scene.gravity = {0.0, -9.81, 0.0};
+    SolidSpec floor;
+    floor.name = "floor";
+    floor.shape.kind = ShapeKind::plane;
+    floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
+    floor.thickness = 1e-3;
+    floor.friction = 0.3;
+    scene.solids.push_back(floor);
+    const Vec3 fired{0.3, -20.0, 0.2};
+    Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+    testing::fold(reference, scene, 1e-3, 0.02, fired);
+    ASSERT_TRUE(testing::advance(reference, scene.steps));
+    ASSERT_GT(reference.self_contact_summary()->max_pairs, 0);
+    for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+      Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+      testing::fold(sim, scene, 1e-3, 0.02, fired);
+      ASSERT_TRUE(testing::advance(sim, scene.steps));
+      EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+          << "split " << split_name(d);
+      EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+          << "split " << split_name(d);
+      EXPECT_EQ(sim.self_contact_summary()->max_pairs, reference.self_contact_summary()->max_pairs);
+      EXPECT_EQ(sim.self_contact_summary()->closest, reference.self_contact_summary()->closest);
+    }
+  }
 }
 
 }  // namespace

@@ -54,6 +54,8 @@ struct RunSummary {
     SolidState state;
   };
   std::vector<SolidReport> solids;
+  // With [self_contact] only: the most pairs held in one step and the closest a held pair came.
+  std::optional<SelfContactSummary> self_contact;
 };
 
 // How a run was laid out and where it wrote, beside what its scene and step loop say.

@@ -111,6 +111,12 @@ struct LinearSolver {
   long jacobian_every = 1;  // steps a Jacobian and its preconditioner serve
 };
 
+// [self_contact]: the cloth kept off its own cells (docs/contact.md, "Self-contact").
+struct SelfContactSpec {
+  double thickness = 0.0;  // m: material.thickness, or its preset's
+  double friction = 0.3;   // Coulomb's μ between the layers
+};
+
 // The per-node fields a run can write beside its positions (docs/output.md, "Fields"), in the
 // order they are written.
 // broken_springs is no choice of [output]: a mass-spring scene that can tear writes it always
@@ -177,6 +183,8 @@ struct Scene {
   // [[solid]]: rigid solids the cloth meets (docs/scene-format.md "Solids"); none: no contact
   // code runs.
   std::vector<SolidSpec> solids;
+  // None: the cloth passes through itself, as it did before self-contact.
+  std::optional<SelfContactSpec> self_contact;
 
   // Warnings the loader found (e.g. a coupling that breaks positive definiteness).
   std::vector<std::string> warnings;

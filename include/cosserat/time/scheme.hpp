@@ -89,6 +89,10 @@ class Scheme {
   // The proposed velocities, for schemes that carry velocities; the others carry r⁻ instead,
   // so changing next_positions() changes their velocity too.
   virtual Field<Vec3>* next_velocities() { return nullptr; }
+  // For the schemes that carry r⁻: the next step's r⁻ where this step's row walk wrote it
+  // (RowReader::begin_walk: a node it settled on a plane starts from r⁺ − Δt v), or null when
+  // that is the current positions; the velocity of a proposed node is (r⁺ − it)/Δt.
+  virtual const Field<Vec3>* next_starts() const { return nullptr; }
   // Whether a step reads forces at intermediate states (midpoint, rk4), which the actions'
   // responses never see: a node beside a contact then takes its neighbours inside the solid
   // for real (Stepper::settle_stage_neighbours).
@@ -148,6 +152,9 @@ class VerletFamily : public Scheme {
 
   std::optional<std::string> advance(long step) final;
   void set_velocities(const NodeVelocities& velocities) override;
+  const Field<Vec3>* next_starts() const override {
+    return walked_starts_ ? &next_previous_ : nullptr;
+  }
   // The backward difference (r − r⁻)/Δt: the velocity half a step back.
   const Field<Vec3>& velocities() override;
   std::vector<StateField> state_fields() override;

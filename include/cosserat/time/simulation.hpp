@@ -4,10 +4,12 @@
 
 #include <mpi.h>
 
+#include <limits>
 #include <memory>
 #include <optional>
 
 #include "cosserat/contact/contact.hpp"
+#include "cosserat/contact/self_contact.hpp"
 #include "cosserat/grid/block.hpp"
 #include "cosserat/grid/decomposition.hpp"
 #include "cosserat/grid/halo.hpp"
@@ -24,6 +26,13 @@ namespace cosserat {
 struct ContactSummary {
   double max_penetration = 0.0;  // m, deepest any node sat inside a solid after a step
   long max_contacts = 0;         // most nodes moved by contact in one step
+};
+
+// What self-contact did over the accepted steps so far, the same on every rank.
+struct SelfContactSummary {
+  long max_pairs = 0;  // most node-triangle pairs closer than the thickness in one step
+  // m: the smallest distance of a held pair after a step (infinite: none met)
+  double closest = std::numeric_limits<double>::infinity();
 };
 
 struct Diagnostics {
@@ -74,6 +83,8 @@ class Simulation {
   // The scene's solids, or null when it has none.
   const Contact* contact() const { return contact_.get(); }
   ContactSummary contact_summary() const;
+  // Nothing when the scene has no [self_contact].
+  std::optional<SelfContactSummary> self_contact_summary() const;
 
   // The stored energy of docs/equations.md §2.5 at the current positions (J); a global sum that
   // costs about one force evaluation, so not part of diagnostics().
@@ -95,10 +106,13 @@ class Simulation {
   Halo halo_;
   Dynamics dynamics_;
   std::unique_ptr<Contact> contact_;
+  std::unique_ptr<SelfContact> self_contact_;
   Stepper stepper_;
   class ModelAction;
   class ContactAction;
+  class SelfContactAction;
   ContactAction* contact_action_ = nullptr;  // owned by stepper_
+  SelfContactAction* self_contact_action_ = nullptr;  // owned by stepper_
 };
 
 }  // namespace cosserat

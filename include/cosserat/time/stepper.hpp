@@ -46,6 +46,8 @@ struct ProposedStep {
   // Per owned row, 0 on entry: an action that marks_moved_rows() sets the rows it moved nodes
   // of, so that the stability check tests only those again. Null when no check needs them.
   std::vector<char>* moved_rows = nullptr;
+  // Schemes that carry r⁻: Scheme::next_starts, null where it is `positions`.
+  const Field<Vec3>* starts = nullptr;
 };
 
 // Something done on every step whatever the scheme (a contact response, a step-size choice):

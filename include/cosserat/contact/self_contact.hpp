@@ -1,0 +1,101 @@
+#pragma once
+// The cloth against its own cells (docs/contact.md, "Self-contact"): a node is kept on the side
+// of every non-neighbouring cell it started the step on, at least the cloth's thickness away,
+// with inelastic normal velocities and Coulomb friction between the layers.
+
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "cosserat/contact/contact.hpp"
+#include "cosserat/contact/solid.hpp"
+#include "cosserat/grid/block.hpp"
+#include "cosserat/grid/vec3.hpp"
+#include "cosserat/model/node_mass.hpp"
+
+namespace cosserat {
+
+// What one step's response found; the same on every rank.
+struct SelfContactStats {
+  long contacts = 0;  // node-triangle pairs closer than the thickness before the response
+  long moved = 0;     // nodes it moved
+  // The smallest distance of a pair it held, after the response, m (infinite: none).
+  double closest = std::numeric_limits<double>::infinity();
+};
+
+class SelfContact {
+ public:
+  // `thickness` (m) and `friction` (μ between layers) from the scene's [self_contact] and
+  // material.thickness; `solids` the scene's, whose fixed planes support the layers on them.
+  SelfContact(double thickness, double friction, const Block& block, const NodeMass& mass,
+              const std::vector<SolidSpec>& solids);
+
+  // The step from `current` to `next` (owned nodes) of length dt, with `next_velocities` when
+  // the scheme carries velocities, else (next − starts)/dt, or (next − current)/dt without
+  // `starts` (ProposedStep::starts). `held` marks, per owned node in
+  // row order, the nodes a fix holds: they move no other node's way. Moves owned nodes of
+  // `next`; writes the velocities it changed into `next_velocities`, or lists them in
+  // `corrected` for the schemes that carry r⁻; marks the rows it moved in `moved_rows` when
+  // given. Collective over the block's ranks.
+  SelfContactStats respond(double dt, const Field<Vec3>& current, Field<Vec3>& next,
+                           Field<Vec3>* next_velocities, const Field<Vec3>* starts,
+                           const std::vector<char>& held, NodeVelocities& corrected,
+                           std::vector<char>* moved_rows);
+
+  double thickness() const { return thickness_; }
+
+ private:
+  // A node p on one side of a cell's triangle (a, b, c), held at the thickness from it along
+  // `normal`: the triangle's at the proposed step, or from its nearest point to p where p's
+  // foot lies beside it.
+  struct Pair {
+    std::int32_t p, a, b, c;  // global node numbers, k + m l
+    double wa, wb, wc;        // p's foot in the triangle, barycentric
+    double side;              // ±1: the side p started the step on
+    double share;             // of the cell's two diagonals
+    Vec3 normal;
+    double impulse = 0.0;  // the normal velocity impulse it gave, per unit of mass
+  };
+
+  void gather(const Field<Vec3>& current, const Field<Vec3>& next,
+              const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
+              const std::vector<char>& held);
+  bool on_floor(const Vec3& x) const;
+  void find_pairs();
+  void separate();
+  void stop_approach_and_slide(double dt);
+
+  // A fixed plane's offset surface: the points x with normal · x = level.
+  struct Floor {
+    Vec3 normal;
+    double level;
+  };
+
+  double thickness_;
+  double friction_;
+  std::vector<Floor> floors_;
+  const Block* block_;
+  NodeMass mass_;
+  int ranks_;
+  std::vector<int> extents_;  // k0, k1, l0, l1 of every rank's block
+  std::vector<int> counts_, offsets_;
+  std::vector<double> send_, receive_;
+
+  // The whole grid, k + m l, on every rank: every rank finds the same pairs and moves every
+  // node the same way, so any decomposition gives the same bits.
+  std::vector<Vec3> start_, end_, velocity_;
+  std::vector<double> inverse_mass_;
+  std::vector<Vec3> move_, kick_;
+  std::vector<double> share_;
+  std::vector<char> touched_;
+  std::vector<Pair> pairs_;
+
+  // The broad phase: every cell's box over the step in buckets of a spatial hash.
+  std::vector<Vec3> box_lo_, box_hi_;
+  std::vector<std::uint32_t> bucket_start_, bucket_cells_;
+  std::vector<std::int32_t> large_cells_;
+  std::vector<std::int32_t> candidates_;
+};
+
+}  // namespace cosserat

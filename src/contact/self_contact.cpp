@@ -1,0 +1,461 @@
+#include "cosserat/contact/self_contact.hpp"
+
+#include <mpi.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace cosserat {
+
+namespace {
+
+// Passes of the position and of the velocity correction (docs/contact.md, "Self-contact"):
+// each moves a node by the mean of what its pairs ask, which never overshoots where several
+// pairs press one node but leaves part of a shared correction to the next pass.
+constexpr int kPasses = 8;
+
+// A node within this fraction of the thickness above a fixed plane's offset surface lies on it.
+constexpr double kOnFloor = 1e-6;
+
+// Numbers per node in the gather: start, end, velocity and the held mark.
+constexpr int kPerNode = 10;
+
+// A cell's box, in spacings of the hash, may cover up to this many buckets; larger cells (a
+// sheet tearing apart) are tested against every node.
+constexpr long kMostBuckets = 27;
+
+struct Foot {
+  double a, b, c;
+  // Within `slack` of the triangle, in barycentric units.
+  bool near(double slack) const { return a >= -slack && b >= -slack && c >= -slack; }
+  // The nearest point of the triangle, approximately: the negative coordinates cut off.
+  Foot clamped() const {
+    const double ca = std::max(a, 0.0), cb = std::max(b, 0.0), cc = std::max(c, 0.0);
+    const double sum = ca + cb + cc;
+    return {ca / sum, cb / sum, cc / sum};
+  }
+};
+
+// The barycentric coordinates of the foot of p on the plane of (a, b, c); all NaN for a
+// triangle with no area.
+Foot foot(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e1 = b - a, e2 = c - a, w = p - a;
+  const double d11 = dot(e1, e1), d12 = dot(e1, e2), d22 = dot(e2, e2);
+  const double w1 = dot(w, e1), w2 = dot(w, e2);
+  const double denominator = d11 * d22 - d12 * d12;
+  const double beta = (d22 * w1 - d12 * w2) / denominator;
+  const double gamma = (d11 * w2 - d12 * w1) / denominator;
+  return {1.0 - beta - gamma, beta, gamma};
+}
+
+Vec3 lerp(const Vec3& a, const Vec3& b, double t) { return a + t * (b - a); }
+
+std::uint64_t bucket_of(std::int64_t i, std::int64_t j, std::int64_t k, std::uint64_t mask) {
+  const auto h = static_cast<std::uint64_t>(i) * 73856093u ^
+                 static_cast<std::uint64_t>(j) * 19349663u ^
+                 static_cast<std::uint64_t>(k) * 83492791u;
+  return h & mask;
+}
+
+}  // namespace
+
+SelfContact::SelfContact(double thickness, double friction, const Block& block,
+                         const NodeMass& mass, const std::vector<SolidSpec>& solids)
+    : thickness_(thickness),
+      friction_(friction),
+      block_(&block),
+      mass_(mass),
+      ranks_(size_of(block.comm)) {
+  for (const SolidSpec& solid : solids)
+    if (solid.shape.kind == ShapeKind::plane && solid.motion == SolidMotion::fixed) {
+      const Vec3 normal = rotate(solid.pose.orientation, {0.0, 0.0, 1.0});
+      floors_.push_back({normal, dot(normal, solid.pose.position) + solid.thickness});
+    }
+  const int mine[4] = {block.k0, block.k1, block.l0, block.l1};
+  extents_.resize(4 * static_cast<std::size_t>(ranks_));
+  MPI_Allgather(mine, 4, MPI_INT, extents_.data(), 4, MPI_INT, block.comm);
+  counts_.resize(static_cast<std::size_t>(ranks_));
+  offsets_.resize(static_cast<std::size_t>(ranks_));
+  int offset = 0;
+  for (int r = 0; r < ranks_; ++r) {
+    const int* e = &extents_[4 * static_cast<std::size_t>(r)];
+    counts_[static_cast<std::size_t>(r)] = kPerNode * (e[1] - e[0]) * (e[3] - e[2]);
+    offsets_[static_cast<std::size_t>(r)] = offset;
+    offset += counts_[static_cast<std::size_t>(r)];
+  }
+  const auto nodes = static_cast<std::size_t>(block.m) * static_cast<std::size_t>(block.n);
+  receive_.resize(static_cast<std::size_t>(offset));
+  send_.resize(static_cast<std::size_t>(kPerNode) * static_cast<std::size_t>(block.owned_k()) *
+               static_cast<std::size_t>(block.owned_l()));
+  start_.resize(nodes);
+  end_.resize(nodes);
+  velocity_.resize(nodes);
+  inverse_mass_.resize(nodes);
+  move_.resize(nodes);
+  kick_.resize(nodes);
+  share_.resize(nodes);
+  touched_.assign(nodes, 0);
+  const auto cells = static_cast<std::size_t>(block.m - 1) * static_cast<std::size_t>(block.n - 1);
+  box_lo_.resize(cells);
+  box_hi_.resize(cells);
+}
+
+// A node on a fixed plane's offset surface or below it (the contact meets the planes before
+// or after this response, docs/contact.md "Cost") is the plane's to hold: the layer above it
+// takes the whole push. Shared, the push would sink the lower node into the plane, which
+// puts it back, and lift the upper one: the stack would climb by its overlap every step.
+bool SelfContact::on_floor(const Vec3& x) const {
+  for (const Floor& floor : floors_)
+    if (dot(floor.normal, x) <= floor.level + kOnFloor * thickness_) return true;
+  return false;
+}
+
+// Every rank takes the whole grid's state of the step: the response below is then the same
+// serial computation on every rank. Its cost grows with the whole grid, not the block
+// (docs/contact.md, "Self-contact", "Cost and limits").
+void SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
+                         const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
+                         const std::vector<char>& held) {
+  const Block& b = *block_;
+  std::size_t at = 0, owned = 0;
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k, ++owned) {
+      const Vec3 r = current(k, l), r1 = next(k, l);
+      const Vec3 v = next_velocities != nullptr ? (*next_velocities)(k, l)
+                     : starts != nullptr        ? (r1 - (*starts)(k, l)) / dt
+                                                : (r1 - r) / dt;
+      for (const Vec3& x : {r, r1, v}) {
+        send_[at++] = x.x;
+        send_[at++] = x.y;
+        send_[at++] = x.z;
+      }
+      send_[at++] = held[owned] != 0 ? 1.0 : 0.0;
+    }
+  if (ranks_ > 1)
+    MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
+                   counts_.data(), offsets_.data(), MPI_DOUBLE, b.comm);
+  else
+    receive_ = send_;
+  for (int rank = 0; rank < ranks_; ++rank) {
+    const int* e = &extents_[4 * static_cast<std::size_t>(rank)];
+    std::size_t from = static_cast<std::size_t>(offsets_[static_cast<std::size_t>(rank)]);
+    for (int l = e[2]; l < e[3]; ++l)
+      for (int k = e[0]; k < e[1]; ++k) {
+        const auto i = static_cast<std::size_t>(k) + static_cast<std::size_t>(b.m) * l;
+        const double* x = &receive_[from];
+        start_[i] = {x[0], x[1], x[2]};
+        end_[i] = {x[3], x[4], x[5]};
+        velocity_[i] = {x[6], x[7], x[8]};
+        inverse_mass_[i] = x[9] != 0.0 || on_floor(end_[i]) ? 0.0 : 1.0 / mass_(k, l);
+        from += kPerNode;
+      }
+  }
+}
+
+// Every cell's box over the step goes into the buckets of a spatial hash whose spacing is twice
+// the mean box; each node's box over the step, grown by the thickness, meets the cells of the
+// buckets it covers. A node meets every triangle it is not a corner of: a crease that folds the
+// cloth back onto itself is held at the thickness as two layers anywhere else are.
+void SelfContact::find_pairs() {
+  const Block& b = *block_;
+  const int m = b.m, n = b.n;
+  const int cells_k = m - 1;
+  const std::size_t cells = box_lo_.size();
+  double extent_sum = 0.0;
+  for (int cl = 0; cl < n - 1; ++cl)
+    for (int ck = 0; ck < cells_k; ++ck) {
+      const std::size_t c = static_cast<std::size_t>(ck) + static_cast<std::size_t>(cells_k) * cl;
+      Vec3 lo = start_[static_cast<std::size_t>(ck) + static_cast<std::size_t>(m) * cl], hi = lo;
+      for (int dl = 0; dl <= 1; ++dl)
+        for (int dk = 0; dk <= 1; ++dk) {
+          const auto i =
+              static_cast<std::size_t>(ck + dk) + static_cast<std::size_t>(m) * (cl + dl);
+          for (const Vec3& x : {start_[i], end_[i]})
+            for (int a = 0; a < 3; ++a) {
+              lo[a] = std::min(lo[a], x[a]);
+              hi[a] = std::max(hi[a], x[a]);
+            }
+        }
+      box_lo_[c] = lo;
+      box_hi_[c] = hi;
+      extent_sum += std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    }
+  const double spacing = std::max(2.0 * extent_sum / static_cast<double>(cells), thickness_);
+  const double inverse = 1.0 / spacing;
+  std::size_t buckets = 1;
+  while (buckets < 2 * cells) buckets *= 2;
+  const std::uint64_t mask = buckets - 1;
+  auto range = [&](const Vec3& lo, const Vec3& hi, std::int64_t* first, std::int64_t* last) {
+    long count = 1;
+    for (int a = 0; a < 3; ++a) {
+      first[a] = static_cast<std::int64_t>(std::floor(lo[a] * inverse));
+      last[a] = static_cast<std::int64_t>(std::floor(hi[a] * inverse));
+      count *= static_cast<long>(std::min<std::int64_t>(last[a] - first[a] + 1, kMostBuckets + 1));
+    }
+    return count;
+  };
+  bucket_start_.assign(buckets + 1, 0);
+  large_cells_.clear();
+  std::int64_t first[3], last[3];
+  for (int pass = 0; pass < 2; ++pass) {
+    for (std::size_t c = 0; c < cells; ++c) {
+      if (range(box_lo_[c], box_hi_[c], first, last) > kMostBuckets) {
+        if (pass == 0) large_cells_.push_back(static_cast<std::int32_t>(c));
+        continue;
+      }
+      for (std::int64_t i = first[0]; i <= last[0]; ++i)
+        for (std::int64_t j = first[1]; j <= last[1]; ++j)
+          for (std::int64_t k = first[2]; k <= last[2]; ++k) {
+            const std::uint64_t bucket = bucket_of(i, j, k, mask);
+            if (pass == 0)
+              ++bucket_start_[bucket + 1];
+            else
+              bucket_cells_[bucket_start_[bucket]++] = static_cast<std::uint32_t>(c);
+          }
+    }
+    if (pass == 0) {
+      for (std::size_t i = 0; i < buckets; ++i) bucket_start_[i + 1] += bucket_start_[i];
+      bucket_cells_.resize(bucket_start_[buckets]);
+    } else {
+      // The fill advanced each bucket's start to the next one's: shift back.
+      for (std::size_t i = buckets; i > 0; --i) bucket_start_[i] = bucket_start_[i - 1];
+      bucket_start_[0] = 0;
+    }
+  }
+
+  pairs_.clear();
+  const double t = thickness_;
+  for (int l = 0; l < n; ++l)
+    for (int k = 0; k < m; ++k) {
+      const auto p = static_cast<std::size_t>(k) + static_cast<std::size_t>(m) * l;
+      const auto q = static_cast<std::int32_t>(p);
+      Vec3 lo = start_[p], hi = lo;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], end_[p][a]) - t;
+        hi[a] = std::max(hi[a], end_[p][a]) + t;
+      }
+      candidates_.clear();
+      auto consider = [&](std::size_t c) {
+        for (int a = 0; a < 3; ++a)
+          if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
+        candidates_.push_back(static_cast<std::int32_t>(c));
+      };
+      if (range(lo, hi, first, last) > kMostBuckets) {
+        for (std::size_t c = 0; c < cells; ++c) consider(c);
+      } else {
+        for (std::int64_t i = first[0]; i <= last[0]; ++i)
+          for (std::int64_t j = first[1]; j <= last[1]; ++j)
+            for (std::int64_t kk = first[2]; kk <= last[2]; ++kk) {
+              const std::uint64_t bucket = bucket_of(i, j, kk, mask);
+              for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
+                consider(bucket_cells_[e]);
+            }
+      }
+      for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+      std::sort(candidates_.begin(), candidates_.end());
+      candidates_.erase(std::unique(candidates_.begin(), candidates_.end()), candidates_.end());
+
+      for (const std::int32_t c : candidates_) {
+        const int ck = c % cells_k, cl = c / cells_k;
+        const auto n00 = static_cast<std::int32_t>(ck + m * cl);
+        const std::int32_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
+        // Both diagonals, each at half weight: no diagonal is preferred (docs/contact.md,
+        // "Symmetry").
+        const std::int32_t triangles[4][3] = {
+            {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
+        for (const auto& tri : triangles) {
+          if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
+          const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
+          const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
+          const Vec3 normal0 = cross(b0 - a0, c0 - a0);
+          const Vec3 normal1 = cross(b1 - a1, c1 - a1);
+          const double area0 = norm(normal0), area1 = norm(normal1);
+          if (!(area0 > 0.0) || !(area1 > 0.0)) continue;
+          const double d0 = dot(normal0, start_[p] - a0) / area0;
+          const double side = d0 >= 0.0 ? 1.0 : -1.0;
+          const Vec3 normal = normal1 / area1;
+          const double d1 = dot(normal, end_[p] - a1);
+          if (side * d1 >= t) continue;
+          // Crossed over the step: where the node met the plane (linearly between the two
+          // distances) must lie in the triangle, or within the thickness of its edges, or it
+          // passed beside it; it goes back to its side along the triangle's normal. Still on
+          // its side: a foot in the triangle holds it along the normal; a foot beside it (a
+          // node at the cloth's border, which has no triangle beyond the edge) is held the
+          // thickness from the triangle's nearest point, along the line from that point:
+          // beyond the triangle the plane's distance is not the triangle's.
+          const double slack = t / std::sqrt(area1);
+          const Foot at_end = foot(end_[p], a1, b1, c1);
+          Foot on = at_end;
+          double pair_side = side;
+          Vec3 direction = normal;
+          if (side * d1 < 0.0) {
+            const double s = d0 / (d0 - d1);
+            const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
+                                       lerp(b0, b1, s), lerp(c0, c1, s));
+            if (!crossing.near(slack) || !at_end.near(1.0)) continue;
+            on = at_end.clamped();
+          } else if (!at_end.near(0.0)) {
+            if (!at_end.near(slack)) continue;
+            on = at_end.clamped();
+            const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
+            const double distance = norm(away);
+            if (distance >= t) continue;
+            if (distance > 0.0) {
+              direction = away / distance;
+              pair_side = 1.0;
+            }
+          }
+          pairs_.push_back(Pair{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2], on.a, on.b,
+                                on.c, pair_side, 0.5, direction});
+        }
+      }
+    }
+}
+
+// Each pass moves every pair's node and triangle apart along the triangle's normal to the
+// thickness, in inverse proportion to their masses (a held node does not move), each node by
+// the mean of its pairs' moves weighted by its share in them.
+void SelfContact::separate() {
+  for (int pass = 0; pass < kPasses; ++pass) {
+    bool any = false;
+    for (const Pair& q : pairs_) {
+      const std::int32_t nodes[4] = {q.p, q.a, q.b, q.c};
+      const double weights[4] = {1.0, -q.wa, -q.wb, -q.wc};
+      Vec3 gap{};
+      double stiffness = 0.0;
+      for (int i = 0; i < 4; ++i) {
+        gap += weights[i] * end_[nodes[i]];
+        stiffness += weights[i] * weights[i] * inverse_mass_[nodes[i]];
+      }
+      const double depth = thickness_ - q.side * dot(q.normal, gap);
+      if (!(depth > 0.0) || !(stiffness > 0.0)) continue;
+      any = true;
+      const double lambda = depth / stiffness;
+      for (int i = 0; i < 4; ++i) {
+        const auto node = static_cast<std::size_t>(nodes[i]);
+        move_[node] += (q.share * lambda * weights[i] * inverse_mass_[node] * q.side) * q.normal;
+        share_[node] += q.share * std::abs(weights[i]);
+        touched_[node] = 1;
+      }
+    }
+    if (!any) break;
+    for (const Pair& q : pairs_)
+      for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
+        const auto i = static_cast<std::size_t>(node);
+        if (share_[i] == 0.0) continue;
+        end_[i] += move_[i] / std::max(1.0, share_[i]);
+        move_[i] = {};
+        share_[i] = 0.0;
+      }
+  }
+}
+
+// Inelastic between the layers: the pairs' relative normal velocity is brought to zero where
+// they approach, in passes as the positions; then Coulomb friction takes off the tangential
+// relative velocity up to μ times each pair's normal impulse, and moves the nodes by Δt times
+// that change, as the solids' friction does (docs/contact.md, "Response").
+void SelfContact::stop_approach_and_slide(double dt) {
+  auto apply = [&](bool friction) {
+    for (const Pair& q : pairs_)
+      for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
+        const auto i = static_cast<std::size_t>(node);
+        if (share_[i] == 0.0) continue;
+        const Vec3 kick = kick_[i] / std::max(1.0, share_[i]);
+        velocity_[i] += kick;
+        if (friction) end_[i] += dt * kick;
+        kick_[i] = {};
+        share_[i] = 0.0;
+      }
+  };
+  for (int pass = 0; pass < kPasses; ++pass) {
+    bool any = false;
+    for (Pair& q : pairs_) {
+      const std::int32_t nodes[4] = {q.p, q.a, q.b, q.c};
+      const double weights[4] = {1.0, -q.wa, -q.wb, -q.wc};
+      Vec3 relative{};
+      double stiffness = 0.0;
+      for (int i = 0; i < 4; ++i) {
+        relative += weights[i] * velocity_[nodes[i]];
+        stiffness += weights[i] * weights[i] * inverse_mass_[nodes[i]];
+      }
+      const double approach = -q.side * dot(q.normal, relative);
+      if (!(approach > 0.0) || !(stiffness > 0.0)) continue;
+      any = true;
+      const double impulse = approach / stiffness;
+      q.impulse += q.share * impulse;
+      for (int i = 0; i < 4; ++i) {
+        const auto node = static_cast<std::size_t>(nodes[i]);
+        kick_[node] += (q.share * impulse * weights[i] * inverse_mass_[node] * q.side) * q.normal;
+        share_[node] += q.share * std::abs(weights[i]);
+        touched_[node] = 1;
+      }
+    }
+    if (!any) break;
+    apply(false);
+  }
+  if (friction_ == 0.0) return;
+  for (const Pair& q : pairs_) {
+    if (!(q.impulse > 0.0)) continue;
+    const std::int32_t nodes[4] = {q.p, q.a, q.b, q.c};
+    const double weights[4] = {1.0, -q.wa, -q.wb, -q.wc};
+    Vec3 relative{};
+    double stiffness = 0.0;
+    for (int i = 0; i < 4; ++i) {
+      relative += weights[i] * velocity_[nodes[i]];
+      stiffness += weights[i] * weights[i] * inverse_mass_[nodes[i]];
+    }
+    const Vec3 slide = relative - dot(relative, q.normal) * q.normal;
+    const double speed = norm(slide);
+    if (!(speed > 0.0) || !(stiffness > 0.0)) continue;
+    // Stick where μ times the normal impulse suffices, else slide with the largest.
+    const double impulse = std::min(speed / stiffness, friction_ * q.impulse / q.share);
+    const Vec3 direction = slide / speed;
+    for (int i = 0; i < 4; ++i) {
+      const auto node = static_cast<std::size_t>(nodes[i]);
+      kick_[node] -= (q.share * impulse * weights[i] * inverse_mass_[node]) * direction;
+      share_[node] += q.share * std::abs(weights[i]);
+    }
+  }
+  apply(true);
+}
+
+SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Field<Vec3>& next,
+                                      Field<Vec3>* next_velocities, const Field<Vec3>* starts,
+                                      const std::vector<char>& held, NodeVelocities& corrected,
+                                      std::vector<char>* moved_rows) {
+  const Block& b = *block_;
+  SelfContactStats stats;
+  gather(current, next, next_velocities, starts, dt, held);
+  // A step that left the grid's numbers (a blow-up) is the stability check's to stop.
+  for (std::size_t i = 0; i < end_.size(); ++i)
+    if (!is_finite(end_[i]) || !is_finite(start_[i])) return stats;
+  find_pairs();
+  stats.contacts = static_cast<long>(pairs_.size());
+  if (pairs_.empty()) return stats;
+  separate();
+  stop_approach_and_slide(dt);
+  for (const Pair& q : pairs_) {
+    const Vec3 gap = end_[q.p] - (q.wa * end_[q.a] + q.wb * end_[q.b] + q.wc * end_[q.c]);
+    stats.closest = std::min(stats.closest, q.side * dot(q.normal, gap));
+  }
+  const auto m = static_cast<std::size_t>(b.m);
+  for (const Pair& q : pairs_)
+    for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
+      const auto i = static_cast<std::size_t>(node);
+      if (touched_[i] == 0) continue;
+      touched_[i] = 0;
+      ++stats.moved;
+      const int k = static_cast<int>(i % m), l = static_cast<int>(i / m);
+      if (!b.owns(k, l)) continue;
+      next(k, l) = end_[i];
+      if (next_velocities != nullptr)
+        (*next_velocities)(k, l) = velocity_[i];
+      else
+        corrected.push_back({k, l, velocity_[i]});
+      if (moved_rows != nullptr) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
+    }
+  return stats;
+}
+
+}  // namespace cosserat

@@ -1,0 +1,176 @@
+// The cloth against itself (docs/contact.md, "Self-contact"): a layer fired at the other at
+// 50 m/s does not pass through it, two layers on a floor stay the thickness apart and lose
+// energy under damping, a run restored from a snapshot continues bitwise, and the scene keys
+// are checked. The layers are a sheet folded at its middle rows (support/layers.hpp).
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cosserat/contact/contact.hpp"
+#include "support/layers.hpp"
+#include "support/sheets.hpp"
+
+namespace cosserat {
+namespace {
+
+// The least height of the top layer over the bottom one: each top node's over the bottom node
+// nearest it across (in x and z), where that lies within a quarter spacing, leaving out the
+// outer columns and the rows next to the fold, which bend away.
+double least_separation(const Simulation& sim, const Scene& s) {
+  const Field<Vec3>& r = sim.positions();
+  const double reach = 0.25 * s.h1();
+  double least = std::numeric_limits<double>::infinity();
+  for (int lt = s.n / 2 + 2; lt < s.n; ++lt)
+    for (int kt = 1; kt < s.m - 1; ++kt) {
+      const Vec3 top = r(kt, lt);
+      for (int l = 0; l < s.n / 2 - 2; ++l)
+        for (int k = 0; k < s.m; ++k) {
+          const Vec3 d = top - r(k, l);
+          if (d.x * d.x + d.z * d.z < reach * reach) least = std::min(least, d.y);
+        }
+    }
+  return least;
+}
+
+// The top layer fired down at 50 m/s, 5 mm a step against a thickness of 2 mm: without
+// self-contact it passes through the bottom layer within a few steps; with it, the layers
+// stay at least half the thickness apart at every step while they move on together.
+TEST(SelfContact, ALayerFiredAtFiftyMetresASecondDoesNotTunnel) {
+  const double thickness = 2e-3;
+  for (const bool on : {false, true}) {
+    Scene s = testing::layered_sheet(thickness);
+    s.dt = 1e-4;
+    if (!on) s.self_contact.reset();
+    Simulation sim(s, MPI_COMM_SELF);
+    testing::fold(sim, s, 0.0, 0.02, {0.0, -50.0, 0.0});
+    double least = std::numeric_limits<double>::infinity();
+    for (int step = 0; step < 100; ++step) {
+      ASSERT_FALSE(sim.step()) << "step " << step;
+      least = std::min(least, least_separation(sim, s));
+    }
+    if (on) {
+      EXPECT_GE(least, 0.5 * thickness);
+      EXPECT_GT(sim.self_contact_summary()->max_pairs, 0);
+    } else {
+      EXPECT_LT(least, -0.05) << "the control must pass through";
+    }
+  }
+}
+
+struct Energies {
+  double total;
+  double kinetic;
+};
+
+Energies energies(Simulation& sim) {
+  const Diagnostics d = sim.diagnostics();
+  return {d.kinetic_energy + d.gravitational_energy + sim.elastic_energy(), d.kinetic_energy};
+}
+
+// The top layer dropped 5 cm (a spacing, so that the fold's edge starts at its rest length)
+// onto the bottom one lying on a floor, with damping: the layers come to rest the thickness
+// apart, and the total energy never rises from one 5 ms frame to the next. (Measured when
+// written: no rise at all, the kinetic energy at the end 1.1e-5 of its peak. Before a foot
+// beside a triangle was held from the triangle's nearest point rather than its plane, the
+// stack chattered by a micrometre a step and rose by up to 2e-4 of the peak.)
+TEST(SelfContact, LayersOnAFloorStayApartAndLoseEnergy) {
+  const double thickness = 2e-3;
+  Scene s = testing::layered_sheet(thickness);
+  s.dt = 1e-4;
+  s.gravity = {0.0, -9.81, 0.0};
+  s.damping = 2.0;
+  SolidSpec floor;
+  floor.name = "floor";
+  floor.shape.kind = ShapeKind::plane;
+  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
+  floor.friction = 0.3;
+  floor.thickness = 1e-3;
+  s.solids.push_back(floor);
+  Simulation sim(s, MPI_COMM_SELF);
+  testing::fold(sim, s, 1e-3, s.h2(), {});
+  Energies last = energies(sim);
+  double peak = last.kinetic, largest_rise = 0.0;
+  for (int frame = 0; frame < 200; ++frame) {
+    ASSERT_TRUE(testing::advance(sim, 50)) << "frame " << frame;
+    const Energies now = energies(sim);
+    largest_rise = std::max(largest_rise, now.total - last.total);
+    peak = std::max(peak, now.kinetic);
+    last = now;
+  }
+  EXPECT_GT(sim.self_contact_summary()->max_pairs, 0);
+  EXPECT_NEAR(least_separation(sim, s), thickness, 0.05 * thickness);
+  EXPECT_LE(largest_rise, 1e-9 * peak);
+  EXPECT_LT(last.kinetic, 1e-4 * peak);
+}
+
+// Self-contact carries no state from step to step beyond what the scheme holds: a run rolled
+// back to a snapshot taken while the layers touch repeats its steps bitwise.
+TEST(SelfContact, ARestoredRunRepeatsItsStepsBitwise) {
+  Scene s = testing::layered_sheet(2e-3);
+  s.dt = 1e-4;
+  Simulation sim(s, MPI_COMM_SELF);
+  testing::fold(sim, s, 0.0, 0.01, {0.0, -10.0, 0.0});
+  ASSERT_TRUE(testing::advance(sim, 20));
+  ASSERT_GT(sim.self_contact_summary()->max_pairs, 0);
+  const Stepper::Snapshot snapshot = sim.stepper().snapshot();
+  ASSERT_TRUE(testing::advance(sim, 30));
+  const Field<Vec3> first = sim.positions();
+  sim.stepper().restore(snapshot);
+  ASSERT_TRUE(testing::advance(sim, 30));
+  const Block& b = sim.block();
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      ASSERT_EQ(sim.positions()(k, l).x, first(k, l).x);
+      ASSERT_EQ(sim.positions()(k, l).y, first(k, l).y);
+      ASSERT_EQ(sim.positions()(k, l).z, first(k, l).z);
+    }
+}
+
+std::string scene_text(const std::string& material, const std::string& self_contact) {
+  return R"(
+[grid]
+nodes = [11, 11]
+size = [0.5, 0.5]
+[material]
+)" + material + R"(
+[time]
+dt = 1e-4
+steps = 10
+)" + self_contact;
+}
+
+TEST(SelfContactScene, ThePresetGivesTheThicknessAndTheSceneMayOverrideIt) {
+  const Scene preset = parse_scene(scene_text("preset = \"denim\"", "[self_contact]\n"), "t");
+  ASSERT_TRUE(preset.self_contact);
+  EXPECT_DOUBLE_EQ(preset.self_contact->thickness, 0.8e-3);
+  EXPECT_DOUBLE_EQ(preset.self_contact->friction, 0.3);
+  const Scene given = parse_scene(
+      scene_text("preset = \"denim\"\nthickness = 0.002", "[self_contact]\nfriction = 0.5\n"),
+      "t");
+  EXPECT_DOUBLE_EQ(given.self_contact->thickness, 0.002);
+  EXPECT_DOUBLE_EQ(given.self_contact->friction, 0.5);
+  EXPECT_FALSE(parse_scene(scene_text("preset = \"denim\"", ""), "t").self_contact);
+}
+
+TEST(SelfContactScene, AMissingOrBadThicknessIsRefused) {
+  const std::string raw = "mass = 0.1\nzeta = 20.0\nxi = 1e-4\nphi = 0.0";
+  EXPECT_THROW(parse_scene(scene_text(raw, "[self_contact]\n"), "t"), SceneError);
+  EXPECT_NO_THROW(parse_scene(scene_text(raw + "\nthickness = 0.001", "[self_contact]\n"), "t"));
+  EXPECT_THROW(parse_scene(scene_text(raw + "\nthickness = -0.001", ""), "t"), SceneError);
+  // Not less than the spacing, 0.05 m.
+  EXPECT_THROW(parse_scene(scene_text(raw + "\nthickness = 0.05", "[self_contact]\n"), "t"),
+               SceneError);
+  EXPECT_THROW(
+      parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nfriction = -0.1\n"), "t"),
+      SceneError);
+  EXPECT_THROW(parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nmu = 0.1\n"), "t"),
+               SceneError);
+}
+
+}  // namespace
+}  // namespace cosserat
