@@ -91,6 +91,16 @@ class SelfContact {
   std::vector<char> touched_;
   std::vector<Pair> pairs_;
 
+  // A triangle's plane: its normal times twice its area at the step's start, and its unit
+  // normal at the end.
+  struct Plane {
+    Vec3 normal0;
+    double area0;
+    Vec3 normal1;
+    double area1;
+  };
+  std::vector<Plane> planes_;  // four a cell, in the order of find_pairs' triangles
+
   // The broad phase: every cell's box over the step in buckets of a spatial hash.
   std::vector<Vec3> box_lo_, box_hi_;
   std::vector<std::uint32_t> bucket_start_, bucket_cells_;
