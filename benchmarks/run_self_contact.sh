@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# What self-contact costs (docs/contact.md, "Self-contact"): node-steps per second of
+# `cosserat run` on the hanging S1-like sheets of jobs/make_large_sheet.sh (no contacts: a
+# hanging sheet does not touch itself) at 120², 240², 512² and 1024², on 1 and 2 threads, with
+# self-contact off and on (material.thickness 0.5 mm); and on scenes with contacts, one thread:
+# S6 with its loads x 5 (scenes/hard/s6_loads_x5.toml, 60², thickness 0.5 mm) and the napkin
+# fold (scenes/contact/napkin_fold.toml, its first 0.5 s, where the fold comes over). Figures from
+# each run's summary. Writes benchmarks/results/self-contact-<host>-<date>.md.
+#   benchmarks/run_self_contact.sh
+set -euo pipefail
+cd "$(dirname "$0")/.."
+source benchmarks/context.sh self-contact release cosserat
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+on=(--set 'self_contact={}' --set material.thickness=0.0005)
+
+rate() {  # threads scene [args...]: node-steps per second from the run's summary
+  local threads=$1 scene=$2
+  shift 2
+  OMP_PROC_BIND=close build/release/cosserat run "$scene" -q --threads "$threads" \
+    -o "$work/run.h5" --overwrite --summary "$work/run.json" "$@" >/dev/null
+  /usr/bin/python3 -c "import json,sys; d=json.load(open(sys.argv[1])); \
+print(f\"{d['node_steps_per_second']:.3e} {(d['self_contact'] or {}).get('max_pairs', '—')}\")" \
+    "$work/run.json"
+}
+
+{
+  echo "# Self-contact's cost, $date"
+  echo
+  echo "Machine: $cpu; compiler: $compiler, release preset; git $revision; 1 rank,"
+  echo "OMP_PROC_BIND=close. \`benchmarks/run_self_contact.sh\`: node-steps/s of \`cosserat run\` from"
+  echo "its summary (output included, every tenth step a frame of the large sheets)."
+  echo
+  echo "| scene | threads | steps | off (node-steps/s) | on | on / off | most pairs in a step |"
+  echo "|---|---|---|---|---|---|---|"
+  for spec in 120:200 240:100 512:20 1024:4; do
+    nodes=${spec%%:*}
+    steps=${spec##*:}
+    jobs/make_large_sheet.sh "$nodes" "$steps" "$work/sheet.toml"
+    for threads in 1 2; do
+      read -r off _ < <(rate "$threads" "$work/sheet.toml")
+      read -r with pairs < <(rate "$threads" "$work/sheet.toml" "${on[@]}")
+      ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
+      echo "| hanging sheet ${nodes}² | $threads | $steps | $off | $with | $ratio | $pairs |"
+    done
+  done
+  read -r off _ < <(rate 1 scenes/hard/s6_loads_x5.toml)
+  read -r with pairs < <(rate 1 scenes/hard/s6_loads_x5.toml "${on[@]}")
+  ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
+  echo "| s6_loads_x5 (60², 20 000 steps) | 1 | 20000 | $off | $with | $ratio | $pairs |"
+  sed '/^\[self_contact\]/,/^$/d' scenes/contact/napkin_fold.toml >"$work/napkin_off.toml"
+  read -r off _ < <(rate 1 "$work/napkin_off.toml" --set time.duration=0.5)
+  read -r with pairs < <(rate 1 scenes/contact/napkin_fold.toml --set time.duration=0.5)
+  ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
+  echo "| napkin_fold (26 × 51, 0.5 s) | 1 | 50000 | $off | $with | $ratio | $pairs |"
+} | tee "$stem.md"
