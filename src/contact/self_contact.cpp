@@ -1,6 +1,7 @@
 #include "cosserat/contact/self_contact.hpp"
 
 #include <mpi.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,6 +18,10 @@ constexpr int kPasses = 8;
 
 // A node within this fraction of the thickness above a fixed plane's offset surface lies on it.
 constexpr double kOnFloor = 1e-6;
+
+// The candidate lists' margin, in grid spacings: a node's box at a build, grown by it, meets the
+// cells of its own four in a flat sheet, and the lists serve until a node moves half of it.
+constexpr double kMargin = 0.25;
 
 // Numbers per node in the gather: start, end, velocity and the held mark.
 constexpr int kPerNode = 10;
@@ -60,10 +65,11 @@ std::uint64_t bucket_of(std::int64_t i, std::int64_t j, std::int64_t k, std::uin
 
 }  // namespace
 
-SelfContact::SelfContact(double thickness, double friction, const Block& block,
+SelfContact::SelfContact(double thickness, double friction, double spacing, const Block& block,
                          const NodeMass& mass, const std::vector<SolidSpec>& solids)
     : thickness_(thickness),
       friction_(friction),
+      margin_(kMargin * spacing),
       block_(&block),
       mass_(mass),
       ranks_(size_of(block.comm)) {
@@ -154,34 +160,13 @@ void SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
 }
 
 // Every cell's box over the step goes into the buckets of a spatial hash whose spacing is the
-// mean box, with eight buckets a cell; each node's box over the step, grown by the thickness,
-// meets the cells of the buckets it covers. (Twice that spacing with two buckets a cell: 40 s
-// against 33 s on scenes/hard/s6_loads_x5.toml, the same pairs.) A node meets every triangle it is not a corner of: a crease that folds the
-// cloth back onto itself is held at the thickness as two layers anywhere else are.
-void SelfContact::find_pairs() {
-  const Block& b = *block_;
-  const int m = b.m, n = b.n;
-  const int cells_k = m - 1;
+// mean box, with eight buckets a cell; each node's box over the step, grown by the thickness and
+// the margin, meets the cells of the buckets it covers. (Twice that spacing with two buckets a
+// cell: 40 s against 33 s on scenes/hard/s6_loads_x5.toml, the same pairs.) Each node's cells
+// are kept in increasing order, so that the pairs come in the same order whatever the build.
+void SelfContact::build_candidates(double extent_sum) {
   const std::size_t cells = box_lo_.size();
-  double extent_sum = 0.0;
-  for (int cl = 0; cl < n - 1; ++cl)
-    for (int ck = 0; ck < cells_k; ++ck) {
-      const std::size_t c = static_cast<std::size_t>(ck) + static_cast<std::size_t>(cells_k) * cl;
-      Vec3 lo = start_[static_cast<std::size_t>(ck) + static_cast<std::size_t>(m) * cl], hi = lo;
-      for (int dl = 0; dl <= 1; ++dl)
-        for (int dk = 0; dk <= 1; ++dk) {
-          const auto i =
-              static_cast<std::size_t>(ck + dk) + static_cast<std::size_t>(m) * (cl + dl);
-          for (const Vec3& x : {start_[i], end_[i]})
-            for (int a = 0; a < 3; ++a) {
-              lo[a] = std::min(lo[a], x[a]);
-              hi[a] = std::max(hi[a], x[a]);
-            }
-        }
-      box_lo_[c] = lo;
-      box_hi_[c] = hi;
-      extent_sum += std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-    }
+  const std::size_t nodes = end_.size();
   const double spacing = std::max(extent_sum / static_cast<double>(cells), thickness_);
   const double inverse = 1.0 / spacing;
   std::size_t buckets = 1;
@@ -225,8 +210,96 @@ void SelfContact::find_pairs() {
     }
   }
 
+  const double reach = thickness_ + margin_;
+  list_start_.assign(nodes + 1, 0);
+  list_cells_.clear();
+  for (std::size_t p = 0; p < nodes; ++p) {
+    Vec3 lo = start_[p], hi = lo;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = std::min(lo[a], end_[p][a]) - reach;
+      hi[a] = std::max(hi[a], end_[p][a]) + reach;
+    }
+    candidates_.clear();
+    auto consider = [&](std::size_t c) {
+      for (int a = 0; a < 3; ++a)
+        if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
+      candidates_.push_back(static_cast<std::int32_t>(c));
+    };
+    if (range(lo, hi, first, last) > kMostBuckets) {
+      for (std::size_t c = 0; c < cells; ++c) consider(c);
+    } else {
+      for (std::int64_t i = first[0]; i <= last[0]; ++i)
+        for (std::int64_t j = first[1]; j <= last[1]; ++j)
+          for (std::int64_t kk = first[2]; kk <= last[2]; ++kk) {
+            const std::uint64_t bucket = bucket_of(i, j, kk, mask);
+            for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
+              consider(bucket_cells_[e]);
+          }
+    }
+    for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+    std::sort(candidates_.begin(), candidates_.end());
+    candidates_.erase(std::unique(candidates_.begin(), candidates_.end()), candidates_.end());
+    list_cells_.insert(list_cells_.end(), candidates_.begin(), candidates_.end());
+    list_start_[p + 1] = static_cast<std::uint32_t>(list_cells_.size());
+  }
+  built_ = end_;
+}
+
+// Each node meets the cells its list holds whose box over the step its own box, grown by the
+// thickness, meets. A node meets every triangle it is not a corner of: a crease that folds the
+// cloth back onto itself is held at the thickness as two layers anywhere else are.
+void SelfContact::find_pairs() {
+  const Block& b = *block_;
+  const int m = b.m, n = b.n;
+  const int cells_k = m - 1;
+  const std::size_t cells = box_lo_.size();
+  // The boxes, the planes and the pairs on the rank's threads, rows in static chunks; the
+  // threads' pairs joined in thread order are the pairs in row order, the same for any count.
+  row_extents_.resize(static_cast<std::size_t>(n - 1));
+#pragma omp parallel for schedule(static)
+  for (int cl = 0; cl < n - 1; ++cl) {
+    double extent_row = 0.0;
+    for (int ck = 0; ck < cells_k; ++ck) {
+      const std::size_t c = static_cast<std::size_t>(ck) + static_cast<std::size_t>(cells_k) * cl;
+      Vec3 lo = start_[static_cast<std::size_t>(ck) + static_cast<std::size_t>(m) * cl], hi = lo;
+      for (int dl = 0; dl <= 1; ++dl)
+        for (int dk = 0; dk <= 1; ++dk) {
+          const auto i =
+              static_cast<std::size_t>(ck + dk) + static_cast<std::size_t>(m) * (cl + dl);
+          for (const Vec3& x : {start_[i], end_[i]})
+            for (int a = 0; a < 3; ++a) {
+              lo[a] = std::min(lo[a], x[a]);
+              hi[a] = std::max(hi[a], x[a]);
+            }
+        }
+      box_lo_[c] = lo;
+      box_hi_[c] = hi;
+      extent_row += std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    }
+    row_extents_[static_cast<std::size_t>(cl)] = extent_row;
+  }
+  double extent_sum = 0.0;
+  for (const double extent : row_extents_) extent_sum += extent;
+  // The candidates of the last build serve while no node has moved more than half the margin
+  // from where it was then (in any coordinate): a cell's box over any later step then lies
+  // within half the margin of its box at the build, and a node's within half the margin of
+  // the node then, so a cell that a node's box grown by the thickness meets later was met by
+  // its box at the build grown by the thickness and the margin. Which steps rebuild changes
+  // no pair: the lists only hold more cells than the test below keeps.
+  const double half_margin = 0.5 * margin_;
+  bool valid = !built_.empty();
+  for (std::size_t i = 0; valid && i < built_.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (!(std::abs(start_[i][a] - built_[i][a]) <= half_margin &&
+            std::abs(end_[i][a] - built_[i][a]) <= half_margin)) {
+        valid = false;
+        break;
+      }
+  if (!valid) build_candidates(extent_sum);
+
   // Every triangle's plane at both ends of the step, once: a node meets a dozen cells.
   planes_.resize(4 * cells);
+#pragma omp parallel for schedule(static)
   for (std::size_t c = 0; c < cells; ++c) {
     const auto n00 = static_cast<std::size_t>(c % static_cast<std::size_t>(cells_k)) +
                      static_cast<std::size_t>(m) * (c / static_cast<std::size_t>(cells_k));
@@ -246,94 +319,87 @@ void SelfContact::find_pairs() {
     }
   }
 
-  pairs_.clear();
   const double t = thickness_;
-  for (int l = 0; l < n; ++l)
-    for (int k = 0; k < m; ++k) {
-      const auto p = static_cast<std::size_t>(k) + static_cast<std::size_t>(m) * l;
-      const auto q = static_cast<std::int32_t>(p);
-      Vec3 lo = start_[p], hi = lo;
-      for (int a = 0; a < 3; ++a) {
-        lo[a] = std::min(lo[a], end_[p][a]) - t;
-        hi[a] = std::max(hi[a], end_[p][a]) + t;
-      }
-      candidates_.clear();
-      auto consider = [&](std::size_t c) {
-        for (int a = 0; a < 3; ++a)
-          if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
-        candidates_.push_back(static_cast<std::int32_t>(c));
-      };
-      if (range(lo, hi, first, last) > kMostBuckets) {
-        for (std::size_t c = 0; c < cells; ++c) consider(c);
-      } else {
-        for (std::int64_t i = first[0]; i <= last[0]; ++i)
-          for (std::int64_t j = first[1]; j <= last[1]; ++j)
-            for (std::int64_t kk = first[2]; kk <= last[2]; ++kk) {
-              const std::uint64_t bucket = bucket_of(i, j, kk, mask);
-              for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
-                consider(bucket_cells_[e]);
+  thread_pairs_.resize(static_cast<std::size_t>(omp_get_max_threads()));
+#pragma omp parallel
+  {
+    std::vector<Pair>& found = thread_pairs_[static_cast<std::size_t>(omp_get_thread_num())];
+    found.clear();
+#pragma omp for schedule(static)
+    for (int l = 0; l < n; ++l)
+      for (int k = 0; k < m; ++k) {
+        const auto p = static_cast<std::size_t>(k) + static_cast<std::size_t>(m) * l;
+        const auto q = static_cast<std::int32_t>(p);
+        Vec3 lo = start_[p], hi = lo;
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], end_[p][a]) - t;
+          hi[a] = std::max(hi[a], end_[p][a]) + t;
+        }
+        for (std::uint32_t e = list_start_[p]; e < list_start_[p + 1]; ++e) {
+          const std::int32_t c = list_cells_[e];
+          bool apart = false;
+          for (int a = 0; a < 3; ++a)
+            apart = apart || box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a];
+          if (apart) continue;
+          const int ck = c % cells_k, cl = c / cells_k;
+          const auto n00 = static_cast<std::int32_t>(ck + m * cl);
+          const std::int32_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
+          // Both diagonals, each at half weight: no diagonal is preferred (docs/contact.md,
+          // "Symmetry").
+          const std::int32_t triangles[4][3] = {
+              {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
+          for (int j = 0; j < 4; ++j) {
+            const auto& tri = triangles[j];
+            if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
+            const Plane& plane =
+                planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
+            if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0)) continue;
+            const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
+            const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
+            const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
+            const double side = d0 >= 0.0 ? 1.0 : -1.0;
+            const Vec3& normal = plane.normal1;
+            const double area1 = plane.area1;
+            const double d1 = dot(normal, end_[p] - a1);
+            if (side * d1 >= t) continue;
+            // Crossed over the step: where the node met the plane (linearly between the two
+            // distances) must lie in the triangle, or within the thickness of its edges, or it
+            // passed beside it; it goes back to its side along the triangle's normal. Still on
+            // its side: a foot in the triangle holds it along the normal; a foot beside it (a
+            // node at the cloth's border, which has no triangle beyond the edge) is held the
+            // thickness from the triangle's nearest point, along the line from that point:
+            // beyond the triangle the plane's distance is not the triangle's.
+            const double slack = t / std::sqrt(area1);
+            const Foot at_end = foot(end_[p], a1, b1, c1);
+            Foot on = at_end;
+            double pair_side = side;
+            Vec3 direction = normal;
+            if (side * d1 < 0.0) {
+              const double s = d0 / (d0 - d1);
+              const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
+                                         lerp(b0, b1, s), lerp(c0, c1, s));
+              if (!crossing.near(slack) || !at_end.near(1.0)) continue;
+              on = at_end.clamped();
+            } else if (!at_end.near(0.0)) {
+              if (!at_end.near(slack)) continue;
+              on = at_end.clamped();
+              const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
+              const double distance = norm(away);
+              if (distance >= t) continue;
+              if (distance > 0.0) {
+                direction = away / distance;
+                pair_side = 1.0;
+              }
             }
-      }
-      for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
-      std::sort(candidates_.begin(), candidates_.end());
-      candidates_.erase(std::unique(candidates_.begin(), candidates_.end()), candidates_.end());
-
-      for (const std::int32_t c : candidates_) {
-        const int ck = c % cells_k, cl = c / cells_k;
-        const auto n00 = static_cast<std::int32_t>(ck + m * cl);
-        const std::int32_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
-        // Both diagonals, each at half weight: no diagonal is preferred (docs/contact.md,
-        // "Symmetry").
-        const std::int32_t triangles[4][3] = {
-            {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
-        for (int j = 0; j < 4; ++j) {
-          const auto& tri = triangles[j];
-          if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
-          const Plane& plane =
-              planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
-          if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0)) continue;
-          const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
-          const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
-          const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
-          const double side = d0 >= 0.0 ? 1.0 : -1.0;
-          const Vec3& normal = plane.normal1;
-          const double area1 = plane.area1;
-          const double d1 = dot(normal, end_[p] - a1);
-          if (side * d1 >= t) continue;
-          // Crossed over the step: where the node met the plane (linearly between the two
-          // distances) must lie in the triangle, or within the thickness of its edges, or it
-          // passed beside it; it goes back to its side along the triangle's normal. Still on
-          // its side: a foot in the triangle holds it along the normal; a foot beside it (a
-          // node at the cloth's border, which has no triangle beyond the edge) is held the
-          // thickness from the triangle's nearest point, along the line from that point:
-          // beyond the triangle the plane's distance is not the triangle's.
-          const double slack = t / std::sqrt(area1);
-          const Foot at_end = foot(end_[p], a1, b1, c1);
-          Foot on = at_end;
-          double pair_side = side;
-          Vec3 direction = normal;
-          if (side * d1 < 0.0) {
-            const double s = d0 / (d0 - d1);
-            const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
-                                       lerp(b0, b1, s), lerp(c0, c1, s));
-            if (!crossing.near(slack) || !at_end.near(1.0)) continue;
-            on = at_end.clamped();
-          } else if (!at_end.near(0.0)) {
-            if (!at_end.near(slack)) continue;
-            on = at_end.clamped();
-            const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
-            const double distance = norm(away);
-            if (distance >= t) continue;
-            if (distance > 0.0) {
-              direction = away / distance;
-              pair_side = 1.0;
-            }
+            found.push_back(Pair{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2], on.a, on.b,
+                                 on.c, pair_side, 0.5, direction});
           }
-          pairs_.push_back(Pair{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2], on.a, on.b,
-                                on.c, pair_side, 0.5, direction});
         }
       }
-    }
+  }
+  pairs_.clear();
+  for (const std::vector<Pair>& found : thread_pairs_)
+    pairs_.insert(pairs_.end(), found.begin(), found.end());
 }
 
 // Each pass moves every pair's node and triangle apart along the triangle's normal to the

@@ -185,7 +185,8 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
                                                scene.gravity, std::min(scene.h1(), scene.h2()))),
       self_contact_(scene.self_contact
                         ? std::make_unique<SelfContact>(scene.self_contact->thickness,
-                                                        scene.self_contact->friction, block_,
+                                                        scene.self_contact->friction,
+                                                        std::min(scene.h1(), scene.h2()), block_,
                                                         dynamics_.node_mass(), scene.solids)
                         : nullptr),
       stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),

@@ -4,6 +4,7 @@
 // are checked. The layers are a sheet folded at its middle rows (support/layers.hpp).
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -129,6 +130,31 @@ TEST(SelfContact, ARestoredRunRepeatsItsStepsBitwise) {
       ASSERT_EQ(sim.positions()(k, l).y, first(k, l).y);
       ASSERT_EQ(sim.positions()(k, l).z, first(k, l).z);
     }
+}
+
+// The pairs are found on the rank's threads, each thread's joined in row order: a layer fired
+// onto another gives the same bits on one thread and on three.
+TEST(SelfContact, ThreadsGiveTheSameBits) {
+  std::vector<std::vector<Vec3>> runs;
+  for (const int threads : {1, 3}) {
+    omp_set_num_threads(threads);
+    Scene s = testing::layered_sheet(2e-3);
+    s.dt = 1e-4;
+    Simulation sim(s, MPI_COMM_SELF);
+    testing::fold(sim, s, 0.0, 0.02, {0.2, -20.0, 0.1});
+    EXPECT_TRUE(testing::advance(sim, 60));
+    EXPECT_GT(sim.self_contact_summary()->max_pairs, 0);
+    std::vector<Vec3> r;
+    for (int l = 0; l < s.n; ++l)
+      for (int k = 0; k < s.m; ++k) r.push_back(sim.positions()(k, l));
+    runs.push_back(r);
+  }
+  omp_set_num_threads(1);
+  for (std::size_t i = 0; i < runs[0].size(); ++i) {
+    ASSERT_EQ(runs[0][i].x, runs[1][i].x) << i;
+    ASSERT_EQ(runs[0][i].y, runs[1][i].y) << i;
+    ASSERT_EQ(runs[0][i].z, runs[1][i].z) << i;
+  }
 }
 
 std::string scene_text(const std::string& material, const std::string& self_contact) {

@@ -27,9 +27,10 @@ struct SelfContactStats {
 class SelfContact {
  public:
   // `thickness` (m) and `friction` (μ between layers) from the scene's [self_contact] and
-  // material.thickness; `solids` the scene's, whose fixed planes support the layers on them.
-  SelfContact(double thickness, double friction, const Block& block, const NodeMass& mass,
-              const std::vector<SolidSpec>& solids);
+  // material.thickness; `spacing` the smaller grid spacing (m); `solids` the scene's, whose
+  // fixed planes support the layers on them.
+  SelfContact(double thickness, double friction, double spacing, const Block& block,
+              const NodeMass& mass, const std::vector<SolidSpec>& solids);
 
   // The step from `current` to `next` (owned nodes) of length dt, with `next_velocities` when
   // the scheme carries velocities, else (next − starts)/dt, or (next − current)/dt without
@@ -62,6 +63,7 @@ class SelfContact {
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
               const std::vector<char>& held);
   bool on_floor(const Vec3& x) const;
+  void build_candidates(double extent_sum);
   void find_pairs();
   void separate();
   void stop_approach_and_slide(double dt);
@@ -74,6 +76,7 @@ class SelfContact {
 
   double thickness_;
   double friction_;
+  double margin_;  // m: how far the candidate lists look beyond the thickness
   std::vector<Floor> floors_;
   const Block* block_;
   NodeMass mass_;
@@ -90,6 +93,8 @@ class SelfContact {
   std::vector<double> share_;
   std::vector<char> touched_;
   std::vector<Pair> pairs_;
+  std::vector<std::vector<Pair>> thread_pairs_;  // each thread's, in its rows' order
+  std::vector<double> row_extents_;              // the cell boxes' sizes, summed by rows
 
   // A triangle's plane: its normal times twice its area at the step's start, and its unit
   // normal at the end.
@@ -106,6 +111,11 @@ class SelfContact {
   std::vector<std::uint32_t> bucket_start_, bucket_cells_;
   std::vector<std::int32_t> large_cells_;
   std::vector<std::int32_t> candidates_;
+  // Each node's candidate cells (list_cells_ from list_start_[p] to list_start_[p + 1]), found
+  // with the nodes at built_.
+  std::vector<std::uint32_t> list_start_;
+  std::vector<std::int32_t> list_cells_;
+  std::vector<Vec3> built_;
 };
 
 }  // namespace cosserat
