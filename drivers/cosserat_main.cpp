@@ -179,7 +179,8 @@ bool fits_in_memory(const cosserat::Scene& scene, const cosserat::Block& block, 
         return !cosserat::node_field(field).vector;
       }));
   const double mine = cosserat::Simulation::memory_bytes(
-      block, scene.integrator, scene.model_spec(), scalar_fields, scene.solids);
+      block, scene.integrator, scene.model_spec(), scalar_fields, scene.solids,
+      scene.self_contact.has_value());
   double needed = 0.0;
   MPI_Allreduce(&mine, &needed, 1, MPI_DOUBLE, MPI_SUM, node);
   int node_rank = 0;

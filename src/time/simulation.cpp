@@ -217,7 +217,7 @@ std::optional<SelfContactSummary> Simulation::self_contact_summary() const {
 
 double Simulation::memory_bytes(const Block& block, Integrator integrator, const ModelSpec& model,
                                 std::size_t scalar_output_fields,
-                                const std::vector<SolidSpec>& solids) {
+                                const std::vector<SolidSpec>& solids, bool self_contact) {
   const double ghosted_nodes = static_cast<double>(block.local_size());
   const double owned_nodes = static_cast<double>(block.owned_k()) * block.owned_l();
   // rk4 keeps nine position-sized fields (state and new state of r and v, acceleration, two
@@ -235,7 +235,8 @@ double Simulation::memory_bytes(const Block& block, Integrator integrator, const
   // its blocks took 10.2 KB.
   const double baseline = is_semi_implicit(integrator) ? 13.5e3 * owned_nodes : 0.0;
   return ghosted_nodes * per_node + row_buffers + output_buffer + baseline +
-         Contact::memory_bytes(block, solids);
+         Contact::memory_bytes(block, solids) +
+         (self_contact ? SelfContact::memory_bytes(block.m, block.n) : 0.0);
 }
 
 void Simulation::node_field(OutputField field, Field<double>& values) const {

@@ -46,6 +46,12 @@ class SelfContact {
 
   double thickness() const { return thickness_; }
 
+  // About what one rank holds for an m x n grid: every rank keeps the whole grid's state of the
+  // step, six positions or velocities and the gather's 10 numbers a node (400 bytes with the
+  // candidate lists), and each cell's box, four planes and eight buckets (370 bytes); the pairs
+  // come on top, a few per node in contact.
+  static double memory_bytes(int m, int n) { return 800.0 * m * n; }
+
  private:
   // A node p on one side of a cell's triangle (a, b, c), held at the thickness from it along
   // `normal`: the triangle's at the proposed step, or from its nearest point to p where p's

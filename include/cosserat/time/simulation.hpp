@@ -58,10 +58,12 @@ class Simulation {
   // Upper bound of the memory one rank's block takes: every field of the most demanding
   // explicit scheme, the force kernel's intermediates, the output buffer and the
   // `scalar_output_fields` fields of node_field() the output keeps, the contact with `solids`,
-  // and for the semi-implicit one its PETSc matrix and colouring.
+  // self-contact where `self_contact`, and for the semi-implicit one its PETSc matrix and
+  // colouring.
   static double memory_bytes(const Block& block, Integrator integrator, const ModelSpec& model,
                              std::size_t scalar_output_fields = 0,
-                             const std::vector<SolidSpec>& solids = {});
+                             const std::vector<SolidSpec>& solids = {},
+                             bool self_contact = false);
 
   std::optional<Instability> step() { return stepper_.step(); }
   long step_index() const { return stepper_.step_index(); }
