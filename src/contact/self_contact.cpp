@@ -402,6 +402,51 @@ void SelfContact::find_pairs() {
     pairs_.insert(pairs_.end(), found.begin(), found.end());
 }
 
+// Σ w_i x_i over a pair's corners (SelfContact::Corners) is the node's offset from its foot, and
+// Σ w_i² / m_i the inverse of the mass the pair moves as one.
+Vec3 SelfContact::across(const Pair& q, const std::vector<Vec3>& x) const {
+  const Corners c = corners(q);
+  Vec3 sum{};
+  for (int i = 0; i < 4; ++i) sum += c.weights[i] * x[static_cast<std::size_t>(c.nodes[i])];
+  return sum;
+}
+
+double SelfContact::inverse_mass(const Pair& q) const {
+  const Corners c = corners(q);
+  double sum = 0.0;
+  for (int i = 0; i < 4; ++i)
+    sum += c.weights[i] * c.weights[i] * inverse_mass_[static_cast<std::size_t>(c.nodes[i])];
+  return sum;
+}
+
+// Adds the pair's `amount` (a move or an impulse, per unit of inverse mass) along
+// `sign` × `direction` to each of its nodes' `sums`, by weight and inverse mass, with the node's
+// share in the pair.
+void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec3& direction,
+                            std::vector<Vec3>& sums) {
+  const Corners c = corners(q);
+  for (int i = 0; i < 4; ++i) {
+    const auto node = static_cast<std::size_t>(c.nodes[i]);
+    sums[node] += (q.share * amount * c.weights[i] * inverse_mass_[node] * sign) * direction;
+    share_[node] += q.share * std::abs(c.weights[i]);
+    touched_[node] = 1;
+  }
+}
+
+// Each node its pairs reached takes the mean of its `sums` by its shares (never more than one
+// pair's worth), and its sum and share are cleared.
+template <class Take>
+void SelfContact::take_means(std::vector<Vec3>& sums, Take take) {
+  for (const Pair& q : pairs_)
+    for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
+      const auto i = static_cast<std::size_t>(node);
+      if (share_[i] == 0.0) continue;
+      take(i, sums[i] / std::max(1.0, share_[i]));
+      sums[i] = {};
+      share_[i] = 0.0;
+    }
+}
+
 // Each pass moves every pair's node and triangle apart along the triangle's normal to the
 // thickness, in inverse proportion to their masses (a held node does not move), each node by
 // the mean of its pairs' moves weighted by its share in them.
@@ -409,34 +454,14 @@ void SelfContact::separate() {
   for (int pass = 0; pass < kPasses; ++pass) {
     bool any = false;
     for (const Pair& q : pairs_) {
-      const std::int32_t nodes[4] = {q.p, q.a, q.b, q.c};
-      const double weights[4] = {1.0, -q.wa, -q.wb, -q.wc};
-      Vec3 gap{};
-      double stiffness = 0.0;
-      for (int i = 0; i < 4; ++i) {
-        gap += weights[i] * end_[nodes[i]];
-        stiffness += weights[i] * weights[i] * inverse_mass_[nodes[i]];
-      }
-      const double depth = thickness_ - q.side * dot(q.normal, gap);
+      const double depth = thickness_ - q.side * dot(q.normal, across(q, end_));
+      const double stiffness = inverse_mass(q);
       if (!(depth > 0.0) || !(stiffness > 0.0)) continue;
       any = true;
-      const double lambda = depth / stiffness;
-      for (int i = 0; i < 4; ++i) {
-        const auto node = static_cast<std::size_t>(nodes[i]);
-        move_[node] += (q.share * lambda * weights[i] * inverse_mass_[node] * q.side) * q.normal;
-        share_[node] += q.share * std::abs(weights[i]);
-        touched_[node] = 1;
-      }
+      share_out(q, depth / stiffness, q.side, q.normal, move_);
     }
     if (!any) break;
-    for (const Pair& q : pairs_)
-      for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
-        const auto i = static_cast<std::size_t>(node);
-        if (share_[i] == 0.0) continue;
-        end_[i] += move_[i] / std::max(1.0, share_[i]);
-        move_[i] = {};
-        share_[i] = 0.0;
-      }
+    take_means(move_, [&](std::size_t i, const Vec3& move) { end_[i] += move; });
   }
 }
 
@@ -445,68 +470,36 @@ void SelfContact::separate() {
 // relative velocity up to μ times each pair's normal impulse, and moves the nodes by Δt times
 // that change, as the solids' friction does (docs/contact.md, "Response").
 void SelfContact::stop_approach_and_slide(double dt) {
-  auto apply = [&](bool friction) {
-    for (const Pair& q : pairs_)
-      for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
-        const auto i = static_cast<std::size_t>(node);
-        if (share_[i] == 0.0) continue;
-        const Vec3 kick = kick_[i] / std::max(1.0, share_[i]);
-        velocity_[i] += kick;
-        if (friction) end_[i] += dt * kick;
-        kick_[i] = {};
-        share_[i] = 0.0;
-      }
-  };
   for (int pass = 0; pass < kPasses; ++pass) {
     bool any = false;
     for (Pair& q : pairs_) {
-      const std::int32_t nodes[4] = {q.p, q.a, q.b, q.c};
-      const double weights[4] = {1.0, -q.wa, -q.wb, -q.wc};
-      Vec3 relative{};
-      double stiffness = 0.0;
-      for (int i = 0; i < 4; ++i) {
-        relative += weights[i] * velocity_[nodes[i]];
-        stiffness += weights[i] * weights[i] * inverse_mass_[nodes[i]];
-      }
-      const double approach = -q.side * dot(q.normal, relative);
+      const double approach = -q.side * dot(q.normal, across(q, velocity_));
+      const double stiffness = inverse_mass(q);
       if (!(approach > 0.0) || !(stiffness > 0.0)) continue;
       any = true;
       const double impulse = approach / stiffness;
       q.impulse += q.share * impulse;
-      for (int i = 0; i < 4; ++i) {
-        const auto node = static_cast<std::size_t>(nodes[i]);
-        kick_[node] += (q.share * impulse * weights[i] * inverse_mass_[node] * q.side) * q.normal;
-        share_[node] += q.share * std::abs(weights[i]);
-        touched_[node] = 1;
-      }
+      share_out(q, impulse, q.side, q.normal, kick_);
     }
     if (!any) break;
-    apply(false);
+    take_means(kick_, [&](std::size_t i, const Vec3& kick) { velocity_[i] += kick; });
   }
   if (friction_ == 0.0) return;
   for (const Pair& q : pairs_) {
     if (!(q.impulse > 0.0)) continue;
-    const std::int32_t nodes[4] = {q.p, q.a, q.b, q.c};
-    const double weights[4] = {1.0, -q.wa, -q.wb, -q.wc};
-    Vec3 relative{};
-    double stiffness = 0.0;
-    for (int i = 0; i < 4; ++i) {
-      relative += weights[i] * velocity_[nodes[i]];
-      stiffness += weights[i] * weights[i] * inverse_mass_[nodes[i]];
-    }
+    const Vec3 relative = across(q, velocity_);
+    const double stiffness = inverse_mass(q);
     const Vec3 slide = relative - dot(relative, q.normal) * q.normal;
     const double speed = norm(slide);
     if (!(speed > 0.0) || !(stiffness > 0.0)) continue;
     // Stick where μ times the normal impulse suffices, else slide with the largest.
     const double impulse = std::min(speed / stiffness, friction_ * q.impulse / q.share);
-    const Vec3 direction = slide / speed;
-    for (int i = 0; i < 4; ++i) {
-      const auto node = static_cast<std::size_t>(nodes[i]);
-      kick_[node] -= (q.share * impulse * weights[i] * inverse_mass_[node]) * direction;
-      share_[node] += q.share * std::abs(weights[i]);
-    }
+    share_out(q, -impulse, 1.0, slide / speed, kick_);
   }
-  apply(true);
+  take_means(kick_, [&](std::size_t i, const Vec3& kick) {
+    velocity_[i] += kick;
+    end_[i] += dt * kick;
+  });
 }
 
 SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Field<Vec3>& next,

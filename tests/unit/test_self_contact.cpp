@@ -109,6 +109,23 @@ TEST(SelfContact, LayersOnAFloorStayApartAndLoseEnergy) {
   EXPECT_LT(last.kinetic, 1e-4 * peak);
 }
 
+std::vector<Vec3> positions(const Simulation& sim) {
+  const Block& b = sim.block();
+  std::vector<Vec3> r;
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) r.push_back(sim.positions()(k, l));
+  return r;
+}
+
+void expect_the_same_bits(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(a[i].x, b[i].x) << i;
+    ASSERT_EQ(a[i].y, b[i].y) << i;
+    ASSERT_EQ(a[i].z, b[i].z) << i;
+  }
+}
+
 // Self-contact carries no state from step to step beyond what the scheme holds: a run rolled
 // back to a snapshot taken while the layers touch repeats its steps bitwise.
 TEST(SelfContact, ARestoredRunRepeatsItsStepsBitwise) {
@@ -120,16 +137,10 @@ TEST(SelfContact, ARestoredRunRepeatsItsStepsBitwise) {
   ASSERT_GT(sim.self_contact_summary()->max_pairs, 0);
   const Stepper::Snapshot snapshot = sim.stepper().snapshot();
   ASSERT_TRUE(testing::advance(sim, 30));
-  const Field<Vec3> first = sim.positions();
+  const std::vector<Vec3> first = positions(sim);
   sim.stepper().restore(snapshot);
   ASSERT_TRUE(testing::advance(sim, 30));
-  const Block& b = sim.block();
-  for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k) {
-      ASSERT_EQ(sim.positions()(k, l).x, first(k, l).x);
-      ASSERT_EQ(sim.positions()(k, l).y, first(k, l).y);
-      ASSERT_EQ(sim.positions()(k, l).z, first(k, l).z);
-    }
+  expect_the_same_bits(positions(sim), first);
 }
 
 // The pairs are found on the rank's threads, each thread's joined in row order: a layer fired
@@ -144,17 +155,10 @@ TEST(SelfContact, ThreadsGiveTheSameBits) {
     testing::fold(sim, s, 0.0, 0.02, {0.2, -20.0, 0.1});
     EXPECT_TRUE(testing::advance(sim, 60));
     EXPECT_GT(sim.self_contact_summary()->max_pairs, 0);
-    std::vector<Vec3> r;
-    for (int l = 0; l < s.n; ++l)
-      for (int k = 0; k < s.m; ++k) r.push_back(sim.positions()(k, l));
-    runs.push_back(r);
+    runs.push_back(positions(sim));
   }
   omp_set_num_threads(1);
-  for (std::size_t i = 0; i < runs[0].size(); ++i) {
-    ASSERT_EQ(runs[0][i].x, runs[1][i].x) << i;
-    ASSERT_EQ(runs[0][i].y, runs[1][i].y) << i;
-    ASSERT_EQ(runs[0][i].z, runs[1][i].z) << i;
-  }
+  expect_the_same_bits(runs[1], runs[0]);
 }
 
 std::string scene_text(const std::string& material, const std::string& self_contact) {

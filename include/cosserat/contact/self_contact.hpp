@@ -64,6 +64,15 @@ class SelfContact {
     Vec3 normal;
     double impulse = 0.0;  // the normal velocity impulse it gave, per unit of mass
   };
+  // A pair's node with weight 1 and its triangle's corners with minus their barycentric
+  // weights.
+  struct Corners {
+    std::int32_t nodes[4];
+    double weights[4];
+  };
+  static Corners corners(const Pair& q) {
+    return {{q.p, q.a, q.b, q.c}, {1.0, -q.wa, -q.wb, -q.wc}};
+  }
 
   void gather(const Field<Vec3>& current, const Field<Vec3>& next,
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
@@ -71,6 +80,12 @@ class SelfContact {
   bool on_floor(const Vec3& x) const;
   void build_candidates(double extent_sum);
   void find_pairs();
+  Vec3 across(const Pair& q, const std::vector<Vec3>& x) const;
+  double inverse_mass(const Pair& q) const;
+  void share_out(const Pair& q, double amount, double sign, const Vec3& direction,
+                 std::vector<Vec3>& sums);
+  template <class Take>
+  void take_means(std::vector<Vec3>& sums, Take take);
   void separate();
   void stop_approach_and_slide(double dt);
 
