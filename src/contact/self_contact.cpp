@@ -527,7 +527,6 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
       const auto i = static_cast<std::size_t>(node);
       if (touched_[i] == 0) continue;
       touched_[i] = 0;
-      ++stats.moved;
       const int k = static_cast<int>(i % m), l = static_cast<int>(i / m);
       if (!b.owns(k, l)) continue;
       next(k, l) = end_[i];

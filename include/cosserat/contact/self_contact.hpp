@@ -1,7 +1,7 @@
 #pragma once
 // The cloth against its own cells (docs/contact.md, "Self-contact"): a node is kept on the side
-// of every non-neighbouring cell it started the step on, at least the cloth's thickness away,
-// with inelastic normal velocities and Coulomb friction between the layers.
+// of every triangle of the grid it is not a corner of where it started the step, at least the
+// cloth's thickness away, with inelastic normal velocities and Coulomb friction between layers.
 
 #include <cstddef>
 #include <cstdint>
@@ -19,7 +19,6 @@ namespace cosserat {
 // What one step's response found; the same on every rank.
 struct SelfContactStats {
   long contacts = 0;  // node-triangle pairs closer than the thickness before the response
-  long moved = 0;     // nodes it moved
   // The smallest distance of a pair it held, after the response, m (infinite: none).
   double closest = std::numeric_limits<double>::infinity();
 };
@@ -34,17 +33,14 @@ class SelfContact {
 
   // The step from `current` to `next` (owned nodes) of length dt, with `next_velocities` when
   // the scheme carries velocities, else (next − starts)/dt, or (next − current)/dt without
-  // `starts` (ProposedStep::starts). `held` marks, per owned node in
-  // row order, the nodes a fix holds: they move no other node's way. Moves owned nodes of
-  // `next`; writes the velocities it changed into `next_velocities`, or lists them in
-  // `corrected` for the schemes that carry r⁻; marks the rows it moved in `moved_rows` when
-  // given. Collective over the block's ranks.
+  // `starts` (ProposedStep::starts). `held` marks, per owned node in row order, the nodes a fix
+  // holds: they move no other node's way. Moves owned nodes of `next`; writes the velocities it
+  // changed into `next_velocities`, or lists them in `corrected` for the schemes that carry r⁻;
+  // marks the rows it moved in `moved_rows` when given. Collective over the block's ranks.
   SelfContactStats respond(double dt, const Field<Vec3>& current, Field<Vec3>& next,
                            Field<Vec3>* next_velocities, const Field<Vec3>* starts,
                            const std::vector<char>& held, NodeVelocities& corrected,
                            std::vector<char>* moved_rows);
-
-  double thickness() const { return thickness_; }
 
   // About what one rank holds for an m x n grid: every rank keeps the whole grid's state of the
   // step, six positions or velocities and the gather's 10 numbers a node (400 bytes with the
