@@ -742,7 +742,8 @@ RunSummary example_summary() {
 }
 
 // The keys of docs/output.md, "Run summary", in its order, with the decomposition and halo time of
-// issue 3 added, and the contact figures (null and empty without solids).
+// issue 3 added, the contact figures (null and empty without solids) and self-contact's (null
+// without it).
 TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
   const std::string json = to_json(example_summary());
   const std::regex key(R"re(\n  "(\w+)":)re");
@@ -759,8 +760,9 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
       "unstable_step", "area_ratio",    "max_speed",      "kinetic_energy",
       "elastic_energy", "gravitational_energy",
       "center_of_mass", "output",        "linear_solves",  "rest",          "adaptive",
-      "max_penetration", "max_contacts", "solids"};
+      "max_penetration", "max_contacts", "solids", "self_contact"};
   EXPECT_EQ(keys, expected);
+  EXPECT_NE(json.find(R"("self_contact": null)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("max_penetration": null,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("solids": [])"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("linear_solves": null,)"), std::string::npos) << json;
@@ -770,6 +772,21 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
   EXPECT_NE(json.find(R"("dt": 0.0001,)"), std::string::npos) << json;
   EXPECT_NE(json.find(R"("center_of_mass": [0.5, -0.25, 0])"), std::string::npos) << json;
   EXPECT_EQ(json.front(), '{');
+}
+
+// Self-contact's figures as an object; a run whose layers never came within the thickness has
+// no closest pair, written null rather than an infinity JSON cannot hold.
+TEST(RunSummaryTest, SelfContactFiguresAreAnObject) {
+  RunSummary summary = example_summary();
+  summary.self_contact = SelfContactSummary{12, 0.0008};
+  std::string json = to_json(summary);
+  EXPECT_NE(json.find(R"("self_contact": {"max_pairs": 12, "closest": 0.0008})"),
+            std::string::npos)
+      << json;
+  summary.self_contact = SelfContactSummary{};
+  json = to_json(summary);
+  EXPECT_NE(json.find(R"("self_contact": {"max_pairs": 0, "closest": null})"), std::string::npos)
+      << json;
 }
 
 // The semi-implicit integrator's solves and --until-rest's result, as objects.
