@@ -91,7 +91,7 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
     offset += counts_[static_cast<std::size_t>(r)];
   }
   const auto nodes = static_cast<std::size_t>(block.m) * static_cast<std::size_t>(block.n);
-  receive_.resize(static_cast<std::size_t>(offset));
+  if (ranks_ > 1) receive_.resize(static_cast<std::size_t>(offset));
   send_.resize(static_cast<std::size_t>(kPerNode) * static_cast<std::size_t>(block.owned_k()) *
                static_cast<std::size_t>(block.owned_l()));
   start_.resize(nodes);
@@ -119,8 +119,8 @@ bool SelfContact::on_floor(const Vec3& x) const {
 
 // Every rank takes the whole grid's state of the step: the response below is then the same
 // serial computation on every rank. Its cost grows with the whole grid, not the block
-// (docs/contact.md, "Self-contact", "Cost and limits").
-void SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
+// (docs/contact.md, "Self-contact", "Cost"). Whether every position is finite.
+bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                          const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
                          const std::vector<char>& held) {
   const Block& b = *block_;
@@ -141,22 +141,24 @@ void SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
   if (ranks_ > 1)
     MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
                    counts_.data(), offsets_.data(), MPI_DOUBLE, b.comm);
-  else
-    receive_ = send_;
+  const std::vector<double>& all = ranks_ > 1 ? receive_ : send_;
+  bool finite = true;
   for (int rank = 0; rank < ranks_; ++rank) {
     const int* e = &extents_[4 * static_cast<std::size_t>(rank)];
     std::size_t from = static_cast<std::size_t>(offsets_[static_cast<std::size_t>(rank)]);
     for (int l = e[2]; l < e[3]; ++l)
       for (int k = e[0]; k < e[1]; ++k) {
         const auto i = static_cast<std::size_t>(k) + static_cast<std::size_t>(b.m) * l;
-        const double* x = &receive_[from];
+        const double* x = &all[from];
         start_[i] = {x[0], x[1], x[2]};
         end_[i] = {x[3], x[4], x[5]};
+        finite = finite && is_finite(start_[i]) && is_finite(end_[i]);
         velocity_[i] = {x[6], x[7], x[8]};
         inverse_mass_[i] = x[9] != 0.0 || on_floor(end_[i]) ? 0.0 : 1.0 / mass_(k, l);
         from += kPerNode;
       }
   }
+  return finite;
 }
 
 // Every cell's box over the step goes into the buckets of a spatial hash whose spacing is the
@@ -508,19 +510,15 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
                                       std::vector<char>* moved_rows) {
   const Block& b = *block_;
   SelfContactStats stats;
-  gather(current, next, next_velocities, starts, dt, held);
   // A step that left the grid's numbers (a blow-up) is the stability check's to stop.
-  for (std::size_t i = 0; i < end_.size(); ++i)
-    if (!is_finite(end_[i]) || !is_finite(start_[i])) return stats;
+  if (!gather(current, next, next_velocities, starts, dt, held)) return stats;
   find_pairs();
   stats.contacts = static_cast<long>(pairs_.size());
   if (pairs_.empty()) return stats;
   separate();
   stop_approach_and_slide(dt);
-  for (const Pair& q : pairs_) {
-    const Vec3 gap = end_[q.p] - (q.wa * end_[q.a] + q.wb * end_[q.b] + q.wc * end_[q.c]);
-    stats.closest = std::min(stats.closest, q.side * dot(q.normal, gap));
-  }
+  for (const Pair& q : pairs_)
+    stats.closest = std::min(stats.closest, q.side * dot(q.normal, across(q, end_)));
   const auto m = static_cast<std::size_t>(b.m);
   for (const Pair& q : pairs_)
     for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {

@@ -70,7 +70,7 @@ class SelfContact {
     return {{q.p, q.a, q.b, q.c}, {1.0, -q.wa, -q.wb, -q.wc}};
   }
 
-  void gather(const Field<Vec3>& current, const Field<Vec3>& next,
+  bool gather(const Field<Vec3>& current, const Field<Vec3>& next,
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
               const std::vector<char>& held);
   bool on_floor(const Vec3& x) const;
@@ -100,7 +100,7 @@ class SelfContact {
   int ranks_;
   std::vector<int> extents_;  // k0, k1, l0, l1 of every rank's block
   std::vector<int> counts_, offsets_;
-  std::vector<double> send_, receive_;
+  std::vector<double> send_, receive_;  // receive_: with several ranks only
 
   // The whole grid, k + m l, on every rank: every rank finds the same pairs and moves every
   // node the same way, so any decomposition gives the same bits.
