@@ -71,7 +71,6 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
       friction_(friction),
       margin_(kMargin * spacing),
       block_(&block),
-      mass_(mass),
       ranks_(size_of(block.comm)) {
   for (const SolidSpec& solid : solids)
     if (solid.shape.kind == ShapeKind::plane && solid.motion == SolidMotion::fixed) {
@@ -91,13 +90,20 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
     offset += counts_[static_cast<std::size_t>(r)];
   }
   const auto nodes = static_cast<std::size_t>(block.m) * static_cast<std::size_t>(block.n);
-  if (ranks_ > 1) receive_.resize(static_cast<std::size_t>(offset));
-  send_.resize(static_cast<std::size_t>(kPerNode) * static_cast<std::size_t>(block.owned_k()) *
-               static_cast<std::size_t>(block.owned_l()));
+  if (ranks_ > 1) {
+    receive_.resize(static_cast<std::size_t>(offset));
+    send_.resize(static_cast<std::size_t>(kPerNode) * static_cast<std::size_t>(block.owned_k()) *
+                 static_cast<std::size_t>(block.owned_l()));
+  }
   start_.resize(nodes);
   end_.resize(nodes);
   velocity_.resize(nodes);
   inverse_mass_.resize(nodes);
+  node_inverse_mass_.resize(nodes);
+  for (int l = 0; l < block.n; ++l)
+    for (int k = 0; k < block.m; ++k)
+      node_inverse_mass_[static_cast<std::size_t>(k) + static_cast<std::size_t>(block.m) * l] =
+          1.0 / mass(k, l);
   move_.resize(nodes);
   kick_.resize(nodes);
   share_.resize(nodes);
@@ -124,38 +130,50 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                          const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
                          const std::vector<char>& held) {
   const Block& b = *block_;
+  bool finite = true;
+  // One node's state into the whole grid's arrays at i = k + m l.
+  auto take = [&](std::size_t i, const Vec3& r, const Vec3& r1, const Vec3& v, bool fixed) {
+    start_[i] = r;
+    end_[i] = r1;
+    finite = finite && is_finite(r) && is_finite(r1);
+    velocity_[i] = v;
+    inverse_mass_[i] = fixed || on_floor(r1) ? 0.0 : node_inverse_mass_[i];
+  };
+  auto velocity = [&](int k, int l) {
+    return next_velocities != nullptr ? (*next_velocities)(k, l)
+           : starts != nullptr        ? (next(k, l) - (*starts)(k, l)) / dt
+                                      : (next(k, l) - current(k, l)) / dt;
+  };
+  const auto m = static_cast<std::size_t>(b.m);
+  // One rank: no message, and no buffer between the fields and the arrays.
+  if (ranks_ == 1) {
+    std::size_t owned = 0;
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k, ++owned)
+        take(static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l), current(k, l),
+             next(k, l), velocity(k, l), held[owned] != 0);
+    return finite;
+  }
   std::size_t at = 0, owned = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k, ++owned) {
-      const Vec3 r = current(k, l), r1 = next(k, l);
-      const Vec3 v = next_velocities != nullptr ? (*next_velocities)(k, l)
-                     : starts != nullptr        ? (r1 - (*starts)(k, l)) / dt
-                                                : (r1 - r) / dt;
-      for (const Vec3& x : {r, r1, v}) {
+      for (const Vec3& x : {current(k, l), next(k, l), velocity(k, l)}) {
         send_[at++] = x.x;
         send_[at++] = x.y;
         send_[at++] = x.z;
       }
       send_[at++] = held[owned] != 0 ? 1.0 : 0.0;
     }
-  if (ranks_ > 1)
-    MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
-                   counts_.data(), offsets_.data(), MPI_DOUBLE, b.comm);
-  const std::vector<double>& all = ranks_ > 1 ? receive_ : send_;
-  bool finite = true;
+  MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
+                 counts_.data(), offsets_.data(), MPI_DOUBLE, b.comm);
   for (int rank = 0; rank < ranks_; ++rank) {
     const int* e = &extents_[4 * static_cast<std::size_t>(rank)];
     std::size_t from = static_cast<std::size_t>(offsets_[static_cast<std::size_t>(rank)]);
     for (int l = e[2]; l < e[3]; ++l)
-      for (int k = e[0]; k < e[1]; ++k) {
-        const auto i = static_cast<std::size_t>(k) + static_cast<std::size_t>(b.m) * l;
-        const double* x = &all[from];
-        start_[i] = {x[0], x[1], x[2]};
-        end_[i] = {x[3], x[4], x[5]};
-        finite = finite && is_finite(start_[i]) && is_finite(end_[i]);
-        velocity_[i] = {x[6], x[7], x[8]};
-        inverse_mass_[i] = x[9] != 0.0 || on_floor(end_[i]) ? 0.0 : 1.0 / mass_(k, l);
-        from += kPerNode;
+      for (int k = e[0]; k < e[1]; ++k, from += kPerNode) {
+        const double* x = &receive_[from];
+        take(static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l), {x[0], x[1], x[2]},
+             {x[3], x[4], x[5]}, {x[6], x[7], x[8]}, x[9] != 0.0);
       }
   }
   return finite;
@@ -169,6 +187,7 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
 void SelfContact::build_candidates(double extent_sum) {
   const std::size_t cells = box_lo_.size();
   const std::size_t nodes = end_.size();
+  const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
   const double spacing = std::max(extent_sum / static_cast<double>(cells), thickness_);
   const double inverse = 1.0 / spacing;
   std::size_t buckets = 1;
@@ -222,7 +241,11 @@ void SelfContact::build_candidates(double extent_sum) {
       hi[a] = std::max(hi[a], end_[p][a]) + reach;
     }
     candidates_.clear();
+    const auto k = static_cast<std::int64_t>(p % m), l = static_cast<std::int64_t>(p / m);
     auto consider = [&](std::size_t c) {
+      const auto dk = static_cast<std::int64_t>(c % cells_k) - k;
+      const auto dl = static_cast<std::int64_t>(c / cells_k) - l;
+      if ((dk == 0 || dk == -1) && (dl == 0 || dl == -1)) return;
       for (int a = 0; a < 3; ++a)
         if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
       candidates_.push_back(static_cast<std::int32_t>(c));
@@ -245,81 +268,94 @@ void SelfContact::build_candidates(double extent_sum) {
     list_start_[p + 1] = static_cast<std::uint32_t>(list_cells_.size());
   }
   built_ = end_;
+  listed_mark_.assign(cells, 0);
+  for (const std::int32_t c : list_cells_) listed_mark_[static_cast<std::size_t>(c)] = 1;
+  listed_.clear();
+  for (std::size_t c = 0; c < cells; ++c)
+    if (listed_mark_[c] != 0) listed_.push_back(static_cast<std::int32_t>(c));
+}
+
+// A cell's box over the step; its largest side.
+double SelfContact::cell_box(std::size_t c) {
+  const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
+  const std::size_t n00 = c % cells_k + m * (c / cells_k);
+  Vec3 lo = start_[n00], hi = lo;
+  for (const std::size_t i : {n00, n00 + 1, n00 + m, n00 + m + 1})
+    for (const Vec3& x : {start_[i], end_[i]})
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], x[a]);
+        hi[a] = std::max(hi[a], x[a]);
+      }
+  box_lo_[c] = lo;
+  box_hi_[c] = hi;
+  return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+}
+
+// A cell's four triangles' planes at both ends of the step, in the order of find_pairs'
+// triangles.
+void SelfContact::cell_planes(std::size_t c) {
+  const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
+  const std::size_t n00 = c % cells_k + m * (c / cells_k);
+  const std::size_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
+  const std::size_t triangles[4][3] = {
+      {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
+  for (int j = 0; j < 4; ++j) {
+    const auto& tri = triangles[j];
+    Plane& plane = planes_[4 * c + static_cast<std::size_t>(j)];
+    const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
+    const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
+    plane.normal0 = cross(b0 - a0, c0 - a0);
+    const Vec3 normal1 = cross(b1 - a1, c1 - a1);
+    plane.area0 = norm(plane.normal0);
+    plane.area1 = norm(normal1);
+    plane.normal1 = normal1 / plane.area1;
+  }
 }
 
 // Each node meets the cells its list holds whose box over the step its own box, grown by the
-// thickness, meets. A node meets every triangle it is not a corner of: a crease that folds the
-// cloth back onto itself is held at the thickness as two layers anywhere else are.
+// thickness, meets: every cell it is not a corner of. A crease that folds the cloth back onto
+// itself is held at the thickness as two layers anywhere else are, from one cell beyond the
+// crease's nodes; within a cell the bending holds the fold (docs/contact.md, "Self-contact").
 void SelfContact::find_pairs() {
   const Block& b = *block_;
   const int m = b.m, n = b.n;
   const int cells_k = m - 1;
-  const std::size_t cells = box_lo_.size();
-  // The boxes, the planes and the pairs on the rank's threads, rows in static chunks; the
-  // threads' pairs joined in thread order are the pairs in row order, the same for any count.
-  row_extents_.resize(static_cast<std::size_t>(n - 1));
-#pragma omp parallel for schedule(static)
-  for (int cl = 0; cl < n - 1; ++cl) {
-    double extent_row = 0.0;
-    for (int ck = 0; ck < cells_k; ++ck) {
-      const std::size_t c = static_cast<std::size_t>(ck) + static_cast<std::size_t>(cells_k) * cl;
-      Vec3 lo = start_[static_cast<std::size_t>(ck) + static_cast<std::size_t>(m) * cl], hi = lo;
-      for (int dl = 0; dl <= 1; ++dl)
-        for (int dk = 0; dk <= 1; ++dk) {
-          const auto i =
-              static_cast<std::size_t>(ck + dk) + static_cast<std::size_t>(m) * (cl + dl);
-          for (const Vec3& x : {start_[i], end_[i]})
-            for (int a = 0; a < 3; ++a) {
-              lo[a] = std::min(lo[a], x[a]);
-              hi[a] = std::max(hi[a], x[a]);
-            }
-        }
-      box_lo_[c] = lo;
-      box_hi_[c] = hi;
-      extent_row += std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-    }
-    row_extents_[static_cast<std::size_t>(cl)] = extent_row;
-  }
-  double extent_sum = 0.0;
-  for (const double extent : row_extents_) extent_sum += extent;
   // The candidates of the last build serve while no node has moved more than half the margin
   // from where it was then (in any coordinate): a cell's box over any later step then lies
   // within half the margin of its box at the build, and a node's within half the margin of
   // the node then, so a cell that a node's box grown by the thickness meets later was met by
   // its box at the build grown by the thickness and the margin. Which steps rebuild changes
   // no pair: the lists only hold more cells than the test below keeps.
-  const double half_margin = 0.5 * margin_;
-  bool valid = !built_.empty();
-  for (std::size_t i = 0; valid && i < built_.size(); ++i)
+  double moved = built_.empty() ? std::numeric_limits<double>::infinity() : 0.0;
+  for (std::size_t i = 0; i < built_.size(); ++i)
     for (int a = 0; a < 3; ++a)
-      if (!(std::abs(start_[i][a] - built_[i][a]) <= half_margin &&
-            std::abs(end_[i][a] - built_[i][a]) <= half_margin)) {
-        valid = false;
-        break;
-      }
-  if (!valid) build_candidates(extent_sum);
-
-  // Every triangle's plane at both ends of the step, once: a node meets a dozen cells.
-  planes_.resize(4 * cells);
+      moved = std::max(
+          {moved, std::abs(start_[i][a] - built_[i][a]), std::abs(end_[i][a] - built_[i][a])});
+  // Only the cells in some node's list need their box and planes between builds: in a sheet
+  // that does not touch itself, none. The boxes, the planes and the pairs on the rank's threads,
+  // rows in static chunks; the threads' pairs joined in thread order are the pairs in row
+  // order, the same for any count.
+  if (!(moved <= 0.5 * margin_)) {
+    row_extents_.resize(static_cast<std::size_t>(n - 1));
 #pragma omp parallel for schedule(static)
-  for (std::size_t c = 0; c < cells; ++c) {
-    const auto n00 = static_cast<std::size_t>(c % static_cast<std::size_t>(cells_k)) +
-                     static_cast<std::size_t>(m) * (c / static_cast<std::size_t>(cells_k));
-    const std::size_t n10 = n00 + 1, n01 = n00 + static_cast<std::size_t>(m), n11 = n01 + 1;
-    const std::size_t triangles[4][3] = {
-        {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
-    for (int j = 0; j < 4; ++j) {
-      const auto& tri = triangles[j];
-      Plane& plane = planes_[4 * c + static_cast<std::size_t>(j)];
-      const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
-      const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
-      plane.normal0 = cross(b0 - a0, c0 - a0);
-      const Vec3 normal1 = cross(b1 - a1, c1 - a1);
-      plane.area0 = norm(plane.normal0);
-      plane.area1 = norm(normal1);
-      plane.normal1 = normal1 / plane.area1;
+    for (int cl = 0; cl < n - 1; ++cl) {
+      double extent_row = 0.0;
+      for (int ck = 0; ck < cells_k; ++ck)
+        extent_row +=
+            cell_box(static_cast<std::size_t>(ck) + static_cast<std::size_t>(cells_k) * cl);
+      row_extents_[static_cast<std::size_t>(cl)] = extent_row;
     }
+    double extent_sum = 0.0;
+    for (const double extent : row_extents_) extent_sum += extent;
+    build_candidates(extent_sum);
+  } else {
+#pragma omp parallel for schedule(static)
+    for (std::size_t e = 0; e < listed_.size(); ++e) cell_box(static_cast<std::size_t>(listed_[e]));
   }
+  planes_.resize(4 * box_lo_.size());
+#pragma omp parallel for schedule(static)
+  for (std::size_t e = 0; e < listed_.size(); ++e)
+    cell_planes(static_cast<std::size_t>(listed_[e]));
 
   const double t = thickness_;
   thread_pairs_.resize(static_cast<std::size_t>(omp_get_max_threads()));
@@ -331,7 +367,7 @@ void SelfContact::find_pairs() {
     for (int l = 0; l < n; ++l)
       for (int k = 0; k < m; ++k) {
         const auto p = static_cast<std::size_t>(k) + static_cast<std::size_t>(m) * l;
-        const auto q = static_cast<std::int32_t>(p);
+        if (list_start_[p] == list_start_[p + 1]) continue;
         Vec3 lo = start_[p], hi = lo;
         for (int a = 0; a < 3; ++a) {
           lo[a] = std::min(lo[a], end_[p][a]) - t;
@@ -352,7 +388,6 @@ void SelfContact::find_pairs() {
               {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
           for (int j = 0; j < 4; ++j) {
             const auto& tri = triangles[j];
-            if (tri[0] == q || tri[1] == q || tri[2] == q) continue;
             const Plane& plane =
                 planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
             if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0)) continue;

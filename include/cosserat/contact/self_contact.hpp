@@ -74,6 +74,8 @@ class SelfContact {
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
               const std::vector<char>& held);
   bool on_floor(const Vec3& x) const;
+  double cell_box(std::size_t c);
+  void cell_planes(std::size_t c);
   void build_candidates(double extent_sum);
   void find_pairs();
   Vec3 across(const Pair& q, const std::vector<Vec3>& x) const;
@@ -96,16 +98,16 @@ class SelfContact {
   double margin_;  // m: how far the candidate lists look beyond the thickness
   std::vector<Floor> floors_;
   const Block* block_;
-  NodeMass mass_;
   int ranks_;
   std::vector<int> extents_;  // k0, k1, l0, l1 of every rank's block
   std::vector<int> counts_, offsets_;
-  std::vector<double> send_, receive_;  // receive_: with several ranks only
+  std::vector<double> send_, receive_;  // with several ranks only
 
   // The whole grid, k + m l, on every rank: every rank finds the same pairs and moves every
   // node the same way, so any decomposition gives the same bits.
   std::vector<Vec3> start_, end_, velocity_;
-  std::vector<double> inverse_mass_;
+  std::vector<double> inverse_mass_;       // this step's: none for a held node or one on a floor
+  std::vector<double> node_inverse_mass_;  // 1 / m of every node
   std::vector<Vec3> move_, kick_;
   std::vector<double> share_;
   std::vector<char> touched_;
@@ -121,7 +123,7 @@ class SelfContact {
     Vec3 normal1;
     double area1;
   };
-  std::vector<Plane> planes_;  // four a cell, in the order of find_pairs' triangles
+  std::vector<Plane> planes_;  // four a cell, in the order of find_pairs' triangles; listed only
 
   // The broad phase: every cell's box over the step in buckets of a spatial hash.
   std::vector<Vec3> box_lo_, box_hi_;
@@ -133,6 +135,10 @@ class SelfContact {
   std::vector<std::uint32_t> list_start_;
   std::vector<std::int32_t> list_cells_;
   std::vector<Vec3> built_;
+  // The cells in some node's list, in increasing order: those whose box and planes a step
+  // needs.
+  std::vector<std::int32_t> listed_;
+  std::vector<char> listed_mark_;
 };
 
 }  // namespace cosserat
