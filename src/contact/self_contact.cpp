@@ -464,8 +464,10 @@ void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec
   const Corners c = corners(q);
   for (int i = 0; i < 4; ++i) {
     const auto node = static_cast<std::size_t>(c.nodes[i]);
+    if (share_[node] == 0.0) pending_.push_back(c.nodes[i]);
     sums[node] += (q.share * amount * c.weights[i] * inverse_mass_[node] * sign) * direction;
     share_[node] += q.share * std::abs(c.weights[i]);
+    if (touched_[node] == 0) moved_.push_back(c.nodes[i]);
     touched_[node] = 1;
   }
 }
@@ -474,14 +476,13 @@ void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec
 // pair's worth), and its sum and share are cleared.
 template <class Take>
 void SelfContact::take_means(std::vector<Vec3>& sums, Take take) {
-  for (const Pair& q : pairs_)
-    for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
-      const auto i = static_cast<std::size_t>(node);
-      if (share_[i] == 0.0) continue;
-      take(i, sums[i] / std::max(1.0, share_[i]));
-      sums[i] = {};
-      share_[i] = 0.0;
-    }
+  for (const std::int32_t node : pending_) {
+    const auto i = static_cast<std::size_t>(node);
+    take(i, sums[i] / std::max(1.0, share_[i]));
+    sums[i] = {};
+    share_[i] = 0.0;
+  }
+  pending_.clear();
 }
 
 // Each pass moves every pair's node and triangle apart along the triangle's normal to the
@@ -492,10 +493,9 @@ void SelfContact::separate() {
     bool any = false;
     for (const Pair& q : pairs_) {
       const double depth = thickness_ - q.side * dot(q.normal, across(q, end_));
-      const double stiffness = inverse_mass(q);
-      if (!(depth > 0.0) || !(stiffness > 0.0)) continue;
+      if (!(depth > 0.0)) continue;
       any = true;
-      share_out(q, depth / stiffness, q.side, q.normal, move_);
+      share_out(q, depth / q.stiffness, q.side, q.normal, move_);
     }
     if (!any) break;
     take_means(move_, [&](std::size_t i, const Vec3& move) { end_[i] += move; });
@@ -511,10 +511,9 @@ void SelfContact::stop_approach_and_slide(double dt) {
     bool any = false;
     for (Pair& q : pairs_) {
       const double approach = -q.side * dot(q.normal, across(q, velocity_));
-      const double stiffness = inverse_mass(q);
-      if (!(approach > 0.0) || !(stiffness > 0.0)) continue;
+      if (!(approach > 0.0)) continue;
       any = true;
-      const double impulse = approach / stiffness;
+      const double impulse = approach / q.stiffness;
       q.impulse += q.share * impulse;
       share_out(q, impulse, q.side, q.normal, kick_);
     }
@@ -525,12 +524,11 @@ void SelfContact::stop_approach_and_slide(double dt) {
   for (const Pair& q : pairs_) {
     if (!(q.impulse > 0.0)) continue;
     const Vec3 relative = across(q, velocity_);
-    const double stiffness = inverse_mass(q);
     const Vec3 slide = relative - dot(relative, q.normal) * q.normal;
     const double speed = norm(slide);
-    if (!(speed > 0.0) || !(stiffness > 0.0)) continue;
+    if (!(speed > 0.0)) continue;
     // Stick where μ times the normal impulse suffices, else slide with the largest.
-    const double impulse = std::min(speed / stiffness, friction_ * q.impulse / q.share);
+    const double impulse = std::min(speed / q.stiffness, friction_ * q.impulse / q.share);
     share_out(q, -impulse, 1.0, slide / speed, kick_);
   }
   take_means(kick_, [&](std::size_t i, const Vec3& kick) {
@@ -549,26 +547,30 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
   if (!gather(current, next, next_velocities, starts, dt, held)) return stats;
   find_pairs();
   stats.contacts = static_cast<long>(pairs_.size());
+  // A pair between held nodes only moves nothing.
+  std::erase_if(pairs_, [&](Pair& q) {
+    q.stiffness = inverse_mass(q);
+    return !(q.stiffness > 0.0);
+  });
   if (pairs_.empty()) return stats;
   separate();
   stop_approach_and_slide(dt);
   for (const Pair& q : pairs_)
     stats.closest = std::min(stats.closest, q.side * dot(q.normal, across(q, end_)));
   const auto m = static_cast<std::size_t>(b.m);
-  for (const Pair& q : pairs_)
-    for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
-      const auto i = static_cast<std::size_t>(node);
-      if (touched_[i] == 0) continue;
-      touched_[i] = 0;
-      const int k = static_cast<int>(i % m), l = static_cast<int>(i / m);
-      if (!b.owns(k, l)) continue;
-      next(k, l) = end_[i];
-      if (next_velocities != nullptr)
-        (*next_velocities)(k, l) = velocity_[i];
-      else
-        corrected.push_back({k, l, velocity_[i]});
-      if (moved_rows != nullptr) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
-    }
+  for (const std::int32_t node : moved_) {
+    const auto i = static_cast<std::size_t>(node);
+    touched_[i] = 0;
+    const int k = static_cast<int>(i % m), l = static_cast<int>(i / m);
+    if (!b.owns(k, l)) continue;
+    next(k, l) = end_[i];
+    if (next_velocities != nullptr)
+      (*next_velocities)(k, l) = velocity_[i];
+    else
+      corrected.push_back({k, l, velocity_[i]});
+    if (moved_rows != nullptr) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
+  }
+  moved_.clear();
   return stats;
 }
 

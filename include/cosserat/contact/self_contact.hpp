@@ -58,7 +58,8 @@ class SelfContact {
     double side;              // ±1: the side p started the step on
     double share;             // of the cell's two diagonals
     Vec3 normal;
-    double impulse = 0.0;  // the normal velocity impulse it gave, per unit of mass
+    double impulse = 0.0;    // the normal velocity impulse it gave, per unit of mass
+    double stiffness = 0.0;  // the inverse of the mass it moves as one (inverse_mass)
   };
   // A pair's node with weight 1 and its triangle's corners with minus their barycentric
   // weights.
@@ -111,6 +112,8 @@ class SelfContact {
   std::vector<Vec3> move_, kick_;
   std::vector<double> share_;
   std::vector<char> touched_;
+  std::vector<std::int32_t> moved_;    // the nodes touched_ marks, in the order first reached
+  std::vector<std::int32_t> pending_;  // the nodes with a share in this pass's sums
   std::vector<Pair> pairs_;
   std::vector<std::vector<Pair>> thread_pairs_;  // each thread's, in its rows' order
   std::vector<double> row_extents_;              // the cell boxes' sizes, summed by rows
