@@ -11,14 +11,24 @@
 # self-proximity, triangles passing through each other, area ratio). Writes
 # benchmarks/results/hard-cases-<host>-<date>.{md,csv} and, in a full run, one picture per
 # scenes/hard scene from its energy-form run (…-<scene>.png). Two runs at a time, each under a timeout.
-#   benchmarks/run_hard_cases.sh [--quick]
+#   benchmarks/run_hard_cases.sh [--quick] [--self-contact]
 # --quick: every run 1/10 of its steps (a check of the script, not results; files *-quick.*).
+# --self-contact: the energy discretisation only, without and with self-contact
+# ([self_contact] with its defaults, docs/contact.md "Self-contact"; material.thickness from the
+# preset, else 0.5 mm, the 10 m calibrations'); files hard-cases-self-contact-*.
 # COSSERAT=path: the binary to run (default build/release/cosserat, built here);
 # HARD_TIMEOUT: seconds per run (default 1200); HARD_JOBS: runs at a time (default 2).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 quick=0
-[[ ${1:-} == --quick ]] && quick=1
+self_contact=0
+for arg in "$@"; do
+  case $arg in
+    --quick) quick=1 ;;
+    --self-contact) self_contact=1 ;;
+    *) echo "usage: benchmarks/run_hard_cases.sh [--quick] [--self-contact]" >&2; exit 2 ;;
+  esac
+done
 if [[ -z ${COSSERAT:-} ]]; then
   source benchmarks/context.sh hard-cases release cosserat
   COSSERAT=build/release/cosserat
@@ -31,6 +41,7 @@ else
   compiler="$(c++ --version | head -1) (binary given as COSSERAT=$COSSERAT)"
   revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 fi
+((self_contact)) && stem=${stem/hard-cases-/hard-cases-self-contact-}
 ((quick)) && stem=$stem-quick
 export COSSERAT OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 export HARD_TIMEOUT=${HARD_TIMEOUT:-1200} QUICK=$quick
@@ -57,6 +68,11 @@ run_one() {  # index label scene steps extra discretisation
   local out=$WORK/$i-$disc
   local model=(--set model.discretisation="\"$disc\"")
   [[ $disc == mass-spring ]] && model=(--set 'model={kind="mass-spring", match="material"}')
+  if [[ $disc == self-contact ]]; then
+    model=(--set 'self_contact={}')
+    grep -q '^preset *=' "$scene" || [[ $extra == *preset* ]] ||
+      model+=(--set material.thickness=0.0005)
+  fi
   local args=(run "$scene" -q -o "$out.h5" --summary "$out.json" "${model[@]}"
     --set time.steps="$steps" --set time.output_every="$every")
   [[ -n $extra ]] && args+=(--set "$extra")
@@ -97,7 +113,9 @@ jobs=$work/jobs
 : >"$jobs"
 for idx in "${!cases[@]}"; do
   IFS='|' read -r label scene steps extra <<<"${cases[$idx]}"
-  for disc in flux energy-nodal energy mass-spring; do
+  discretisations=(flux energy-nodal energy mass-spring)
+  ((self_contact)) && discretisations=(energy self-contact)
+  for disc in "${discretisations[@]}"; do
     printf '%s\0%s\0%s\0%s\0%s\0%s\0' "$idx" "$label" "$scene" "$steps" "$extra" "$disc" >>"$jobs"
   done
 done
@@ -115,7 +133,9 @@ if ((!quick)); then
   for s in silk_square cotton_square denim_square s6_loads_x5 s6_xi0 s4_flag_preset crumple; do
     for idx in "${!cases[@]}"; do
       [[ ${cases[$idx]%%|*} == "$s" ]] || continue
-      /usr/bin/python3 tools/render.py "$work/$idx-energy.h5" --frame -1 --output "$stem-$s.png" \
+      pictured=energy
+      ((self_contact)) && pictured=self-contact
+      /usr/bin/python3 tools/render.py "$work/$idx-$pictured.h5" --frame -1 --output "$stem-$s.png" \
         >/dev/null 2>&1 ||
         echo "render of $s failed" >&2
     done
@@ -128,7 +148,8 @@ import csv, glob, json, sys
 work, stem, date, cpu, compiler, revision, threads, total, quick, timeout, version = sys.argv[1:]
 rows = sorted((json.load(open(p)) for p in glob.glob(work + "/*.row.json")),
               key=lambda r: (r["index"],
-                             ["flux", "energy-nodal", "energy", "mass-spring"].index(
+                             ["flux", "energy-nodal", "energy", "mass-spring",
+                              "self-contact"].index(
                                  r["discretisation"])))
 def g(r, k, fmt):
     q = r.get("quality") or {}
@@ -156,10 +177,12 @@ with open(stem + ".csv", "w", newline="") as f:
     w = csv.writer(f)
     w.writerow(cols)
     w.writerows(table)
-lines = [f"# Hard cases: the flux, nodal energy and energy discretisations and matched springs, {date}" + (" (QUICK: 1/10 of every run)" if quick == "1" else ""), "",
+title = ("the energy discretisation without and with self-contact" if "self-contact" in stem
+         else "the flux, nodal energy and energy discretisations and matched springs")
+lines = [f"# Hard cases: {title}, {date}" + (" (QUICK: 1/10 of every run)" if quick == "1" else ""), "",
          f"Machine: {cpu}; compiler: {compiler}, release; git {revision}; binary `{version}`; "
          f"1 rank x {threads} thread(s), two runs at a time; per-run timeout {timeout} s.",
-         f"`benchmarks/run_hard_cases.sh{' --quick' if quick == '1' else ''}`; whole suite {int(total) // 60} min {int(total) % 60} s of wall time. "
+         f"`benchmarks/run_hard_cases.sh{' --quick' if quick == '1' else ''}{' --self-contact' if 'self-contact' in stem else ''}`; whole suite {int(total) // 60} min {int(total) % 60} s of wall time. "
          "Quality measures are over the frames written (100 a run, plus the last good state of a "
          "run stopped by the monitor): tools/sheet_quality.py. \"min far distance / h\": "
          "the smallest distance of two nodes more than 3 indices apart, where one is within h; "
