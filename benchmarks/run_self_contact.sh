@@ -33,7 +33,7 @@ print(f\"{d['node_steps_per_second']:.3e} {(d['self_contact'] or {}).get('max_pa
   echo
   echo "| scene | threads | steps | off (node-steps/s) | on | on / off | most pairs in a step |"
   echo "|---|---|---|---|---|---|---|"
-  for spec in 120:200 240:100 512:20 1024:4; do
+  for spec in 120:200 240:100 512:40 1024:20; do
     nodes=${spec%%:*}
     steps=${spec##*:}
     jobs/make_large_sheet.sh "$nodes" "$steps" "$work/sheet.toml"
