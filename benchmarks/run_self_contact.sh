@@ -5,7 +5,8 @@
 # self-contact off and on (material.thickness 0.5 mm); and on scenes with contacts, one thread:
 # S6 with its loads x 5 (scenes/hard/s6_loads_x5.toml, 60², thickness 0.5 mm) and the napkin
 # fold (scenes/contact/napkin_fold.toml, its first 0.5 s, where the fold comes over). Figures from
-# each run's summary. Writes benchmarks/results/self-contact-<host>-<date>.md.
+# each run's summary; and the 1024² sheet's cost a step once the candidate lists are built.
+# Writes benchmarks/results/self-contact-<host>-<date>.md.
 #   benchmarks/run_self_contact.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,6 +23,18 @@ rate() {  # threads scene [args...]: node-steps per second from the run's summar
   /usr/bin/python3 -c "import json,sys; d=json.load(open(sys.argv[1])); \
 print(f\"{d['node_steps_per_second']:.3e} {(d['self_contact'] or {}).get('max_pairs', '—')}\")" \
     "$work/run.json"
+}
+
+best() {  # repeats threads steps [args...]: the least wall time of the 1024² sheet's runs
+  local repeats=$1 threads=$2 steps=$3
+  shift 3
+  for ((i = 0; i < repeats; ++i)); do
+    OMP_PROC_BIND=close build/release/cosserat run "$work/sheet.toml" -q --threads "$threads" \
+      -o "$work/run.h5" --overwrite --summary "$work/run.json" --set time.steps="$steps" \
+      --set time.output_every="$steps" "$@" >/dev/null
+    /usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['wall_seconds'])" \
+      "$work/run.json"
+  done | sort -g | head -1
 }
 
 {
@@ -44,6 +57,24 @@ print(f\"{d['node_steps_per_second']:.3e} {(d['self_contact'] or {}).get('max_pa
       echo "| hanging sheet ${nodes}² | $threads | $steps | $off | $with | $ratio | $pairs |"
     done
   done
+  echo
+  echo "The 1024² sheet's step after the first, which builds the candidate lists: from runs of 60"
+  echo "and 120 steps with one frame each, (wall(120) − wall(60)) / 60, the best of three of each."
+  echo
+  echo "| threads | off (ms a step) | on (ms a step) | on / off − 1 | the build, s |"
+  echo "|---|---|---|---|---|"
+  jobs/make_large_sheet.sh 1024 60 "$work/sheet.toml"
+  for threads in 1 2; do
+    off60=$(best 3 "$threads" 60) off120=$(best 3 "$threads" 120)
+    on60=$(best 3 "$threads" 60 "${on[@]}") on120=$(best 3 "$threads" 120 "${on[@]}")
+    /usr/bin/python3 -c "
+off, on = ($off120 - $off60) / 60, ($on120 - $on60) / 60
+build = ($on60 - $off60) - 60 * (on - off)
+print(f'| $threads | {1e3 * off:.1f} | {1e3 * on:.1f} | {on / off - 1:+.0%} | {build:.2f} |')"
+  done
+  echo
+  echo "| scene | threads | steps | off (node-steps/s) | on | on / off | most pairs in a step |"
+  echo "|---|---|---|---|---|---|---|"
   read -r off _ < <(rate 1 scenes/hard/s6_loads_x5.toml)
   read -r with pairs < <(rate 1 scenes/hard/s6_loads_x5.toml "${on[@]}")
   ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")

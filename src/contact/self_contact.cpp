@@ -56,6 +56,14 @@ Foot foot(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
 
 Vec3 lerp(const Vec3& a, const Vec3& b, double t) { return a + t * (b - a); }
 
+// A node's velocity at the step's end (SelfContact::respond).
+Vec3 velocity_of(int k, int l, double dt, const Field<Vec3>& current, const Field<Vec3>& next,
+                 const Field<Vec3>* next_velocities, const Field<Vec3>* starts) {
+  return next_velocities != nullptr ? (*next_velocities)(k, l)
+         : starts != nullptr        ? (next(k, l) - (*starts)(k, l)) / dt
+                                    : (next(k, l) - current(k, l)) / dt;
+}
+
 std::uint64_t bucket_of(std::int64_t i, std::int64_t j, std::int64_t k, std::uint64_t mask) {
   const auto h = static_cast<std::uint64_t>(i) * 73856093u ^
                  static_cast<std::uint64_t>(j) * 19349663u ^
@@ -131,33 +139,33 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                          const std::vector<char>& held) {
   const Block& b = *block_;
   bool finite = true;
-  // One node's state into the whole grid's arrays at i = k + m l.
-  auto take = [&](std::size_t i, const Vec3& r, const Vec3& r1, const Vec3& v, bool fixed) {
+  // How far a node has gone from where the candidate lists were built (find_pairs).
+  const bool built = !built_.empty();
+  drift_ = built ? 0.0 : std::numeric_limits<double>::infinity();
+  // One node's positions into the whole grid's arrays at i = k + m l.
+  auto take = [&](std::size_t i, const Vec3& r, const Vec3& r1) {
     start_[i] = r;
     end_[i] = r1;
     finite = finite && is_finite(r) && is_finite(r1);
-    velocity_[i] = v;
-    inverse_mass_[i] = fixed || on_floor(r1) ? 0.0 : node_inverse_mass_[i];
-  };
-  auto velocity = [&](int k, int l) {
-    return next_velocities != nullptr ? (*next_velocities)(k, l)
-           : starts != nullptr        ? (next(k, l) - (*starts)(k, l)) / dt
-                                      : (next(k, l) - current(k, l)) / dt;
+    if (built)
+      for (int a = 0; a < 3; ++a)
+        drift_ = std::max({drift_, std::abs(r[a] - built_[i][a]), std::abs(r1[a] - built_[i][a])});
   };
   const auto m = static_cast<std::size_t>(b.m);
-  // One rank: no message, and no buffer between the fields and the arrays.
+  // One rank: no message, no buffer between the fields and the arrays, and the velocities and
+  // masses only of the nodes the pairs reach (respond).
   if (ranks_ == 1) {
-    std::size_t owned = 0;
     for (int l = b.l0; l < b.l1; ++l)
-      for (int k = b.k0; k < b.k1; ++k, ++owned)
+      for (int k = b.k0; k < b.k1; ++k)
         take(static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l), current(k, l),
-             next(k, l), velocity(k, l), held[owned] != 0);
+             next(k, l));
     return finite;
   }
   std::size_t at = 0, owned = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k, ++owned) {
-      for (const Vec3& x : {current(k, l), next(k, l), velocity(k, l)}) {
+      for (const Vec3& x : {current(k, l), next(k, l),
+                            velocity_of(k, l, dt, current, next, next_velocities, starts)}) {
         send_[at++] = x.x;
         send_[at++] = x.y;
         send_[at++] = x.z;
@@ -172,11 +180,18 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
     for (int l = e[2]; l < e[3]; ++l)
       for (int k = e[0]; k < e[1]; ++k, from += kPerNode) {
         const double* x = &receive_[from];
-        take(static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l), {x[0], x[1], x[2]},
-             {x[3], x[4], x[5]}, {x[6], x[7], x[8]}, x[9] != 0.0);
+        const auto i = static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l);
+        take(i, {x[0], x[1], x[2]}, {x[3], x[4], x[5]});
+        motion(i, {x[6], x[7], x[8]}, x[9] != 0.0);
       }
   }
   return finite;
+}
+
+// A node's velocity and inverse mass for the response: none for a held node or one on a floor.
+void SelfContact::motion(std::size_t i, const Vec3& velocity, bool held) {
+  velocity_[i] = velocity;
+  inverse_mass_[i] = held || on_floor(end_[i]) ? 0.0 : node_inverse_mass_[i];
 }
 
 // Every cell's box over the step goes into the buckets of a spatial hash whose spacing is the
@@ -242,12 +257,13 @@ void SelfContact::build_candidates(double extent_sum) {
     }
     candidates_.clear();
     const auto k = static_cast<std::int64_t>(p % m), l = static_cast<std::int64_t>(p / m);
+    // The boxes first: most cells fail them, and the test of the node's own cells divides.
     auto consider = [&](std::size_t c) {
+      for (int a = 0; a < 3; ++a)
+        if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
       const auto dk = static_cast<std::int64_t>(c % cells_k) - k;
       const auto dl = static_cast<std::int64_t>(c / cells_k) - l;
       if ((dk == 0 || dk == -1) && (dl == 0 || dl == -1)) return;
-      for (int a = 0; a < 3; ++a)
-        if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
       candidates_.push_back(static_cast<std::int32_t>(c));
     };
     if (range(lo, hi, first, last) > kMostBuckets) {
@@ -326,16 +342,11 @@ void SelfContact::find_pairs() {
   // the node then, so a cell that a node's box grown by the thickness meets later was met by
   // its box at the build grown by the thickness and the margin. Which steps rebuild changes
   // no pair: the lists only hold more cells than the test below keeps.
-  double moved = built_.empty() ? std::numeric_limits<double>::infinity() : 0.0;
-  for (std::size_t i = 0; i < built_.size(); ++i)
-    for (int a = 0; a < 3; ++a)
-      moved = std::max(
-          {moved, std::abs(start_[i][a] - built_[i][a]), std::abs(end_[i][a] - built_[i][a])});
   // Only the cells in some node's list need their box and planes between builds: in a sheet
   // that does not touch itself, none. The boxes, the planes and the pairs on the rank's threads,
   // rows in static chunks; the threads' pairs joined in thread order are the pairs in row
   // order, the same for any count.
-  if (!(moved <= 0.5 * margin_)) {
+  if (!(drift_ <= 0.5 * margin_)) {
     row_extents_.resize(static_cast<std::size_t>(n - 1));
 #pragma omp parallel for schedule(static)
     for (int cl = 0; cl < n - 1; ++cl) {
@@ -547,6 +558,16 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
   if (!gather(current, next, next_velocities, starts, dt, held)) return stats;
   find_pairs();
   stats.contacts = static_cast<long>(pairs_.size());
+  if (ranks_ == 1)
+    for (const Pair& q : pairs_)
+      for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
+        const auto i = static_cast<std::size_t>(node);
+        const int k = static_cast<int>(i % static_cast<std::size_t>(b.m));
+        const int l = static_cast<int>(i / static_cast<std::size_t>(b.m));
+        motion(i, velocity_of(k, l, dt, current, next, next_velocities, starts),
+               held[static_cast<std::size_t>(l - b.l0) * static_cast<std::size_t>(b.owned_k()) +
+                    static_cast<std::size_t>(k - b.k0)] != 0);
+      }
   // A pair between held nodes only moves nothing.
   std::erase_if(pairs_, [&](Pair& q) {
     q.stiffness = inverse_mass(q);

@@ -74,6 +74,7 @@ class SelfContact {
   bool gather(const Field<Vec3>& current, const Field<Vec3>& next,
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
               const std::vector<char>& held);
+  void motion(std::size_t i, const Vec3& velocity, bool held);
   bool on_floor(const Vec3& x) const;
   double cell_box(std::size_t c);
   void cell_planes(std::size_t c);
@@ -138,6 +139,7 @@ class SelfContact {
   std::vector<std::uint32_t> list_start_;
   std::vector<std::int32_t> list_cells_;
   std::vector<Vec3> built_;
+  double drift_ = 0.0;  // the farthest any node has gone from built_, in one coordinate, m
   // The cells in some node's list, in increasing order: those whose box and planes a step
   // needs.
   std::vector<std::int32_t> listed_;
