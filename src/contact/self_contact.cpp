@@ -401,7 +401,12 @@ void SelfContact::find_pairs() {
             const auto& tri = triangles[j];
             const Plane& plane =
                 planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
-            if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0)) continue;
+            // A triangle that turned over in the step (a cell collapsing through itself) has no
+            // side to keep: every node near it would seem to have crossed it, by as much as the
+            // triangle's size, and be thrown that far.
+            if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0) ||
+                !(dot(plane.normal0, plane.normal1) > 0.0))
+              continue;
             const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
             const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
             const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
