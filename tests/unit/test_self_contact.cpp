@@ -1,7 +1,8 @@
 // The cloth against itself (docs/contact.md, "Self-contact"): a layer fired at the other at
 // 50 m/s does not pass through it, a triangle turned over in a step throws no node, two layers
 // on a floor stay the thickness apart and lose energy under damping, a run restored from a
-// snapshot continues bitwise, and the scene keys are checked. The layers are a sheet folded at its middle rows (support/layers.hpp).
+// snapshot continues bitwise, and the scene keys are checked. The layers are a sheet folded at
+// its middle rows (support/layers.hpp).
 
 #include <gtest/gtest.h>
 #include <omp.h>
