@@ -36,6 +36,14 @@ cpu_set_t affinity_mask() {
     const long online = online_cpus();
     for (long cpu = 0; cpu < online; ++cpu) CPU_SET(static_cast<int>(cpu), &mask);
   }
+  // With OMP_PROC_BIND the runtime binds the initial thread to its first place as it starts,
+  // so the thread's own mask holds one core: the rank's CPUs are all its places'.
+  if (omp_get_proc_bind() != omp_proc_bind_false)
+    for (int place = 0; place < omp_get_num_places(); ++place) {
+      std::vector<int> ids(static_cast<std::size_t>(omp_get_place_num_procs(place)));
+      omp_get_place_proc_ids(place, ids.data());
+      for (const int id : ids) CPU_SET(id, &mask);
+    }
   return mask;
 }
 
