@@ -248,41 +248,59 @@ void SelfContact::build_candidates(double extent_sum) {
 
   const double reach = thickness_ + margin_;
   list_start_.assign(nodes + 1, 0);
-  list_cells_.clear();
-  for (std::size_t p = 0; p < nodes; ++p) {
-    Vec3 lo = start_[p], hi = lo;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = std::min(lo[a], end_[p][a]) - reach;
-      hi[a] = std::max(hi[a], end_[p][a]) + reach;
+  // Each thread lists a static chunk of the nodes, counting each node's cells into
+  // list_start_; the chunks joined in thread order are the lists in node order, the same for
+  // any count.
+  const auto threads = static_cast<std::size_t>(omp_get_max_threads());
+  thread_lists_.resize(threads);
+  thread_candidates_.resize(threads);
+#pragma omp parallel
+  {
+    const auto me = static_cast<std::size_t>(omp_get_thread_num());
+    std::vector<std::int32_t>& found = thread_lists_[me];
+    std::vector<std::int32_t>& candidates = thread_candidates_[me];
+    found.clear();
+    std::int64_t from[3], to[3];
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < nodes; ++p) {
+      Vec3 lo = start_[p], hi = lo;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], end_[p][a]) - reach;
+        hi[a] = std::max(hi[a], end_[p][a]) + reach;
+      }
+      candidates.clear();
+      const auto k = static_cast<std::int64_t>(p % m), l = static_cast<std::int64_t>(p / m);
+      // The boxes first: most cells fail them, and the test of the node's own cells divides.
+      auto consider = [&](std::size_t c) {
+        for (int a = 0; a < 3; ++a)
+          if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
+        const auto dk = static_cast<std::int64_t>(c % cells_k) - k;
+        const auto dl = static_cast<std::int64_t>(c / cells_k) - l;
+        if ((dk == 0 || dk == -1) && (dl == 0 || dl == -1)) return;
+        candidates.push_back(static_cast<std::int32_t>(c));
+      };
+      if (range(lo, hi, from, to) > kMostBuckets) {
+        for (std::size_t c = 0; c < cells; ++c) consider(c);
+      } else {
+        for (std::int64_t i = from[0]; i <= to[0]; ++i)
+          for (std::int64_t j = from[1]; j <= to[1]; ++j)
+            for (std::int64_t kk = from[2]; kk <= to[2]; ++kk) {
+              const std::uint64_t bucket = bucket_of(i, j, kk, mask);
+              for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
+                consider(bucket_cells_[e]);
+            }
+      }
+      for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+      std::sort(candidates.begin(), candidates.end());
+      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+      found.insert(found.end(), candidates.begin(), candidates.end());
+      list_start_[p + 1] = static_cast<std::uint32_t>(candidates.size());
     }
-    candidates_.clear();
-    const auto k = static_cast<std::int64_t>(p % m), l = static_cast<std::int64_t>(p / m);
-    // The boxes first: most cells fail them, and the test of the node's own cells divides.
-    auto consider = [&](std::size_t c) {
-      for (int a = 0; a < 3; ++a)
-        if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
-      const auto dk = static_cast<std::int64_t>(c % cells_k) - k;
-      const auto dl = static_cast<std::int64_t>(c / cells_k) - l;
-      if ((dk == 0 || dk == -1) && (dl == 0 || dl == -1)) return;
-      candidates_.push_back(static_cast<std::int32_t>(c));
-    };
-    if (range(lo, hi, first, last) > kMostBuckets) {
-      for (std::size_t c = 0; c < cells; ++c) consider(c);
-    } else {
-      for (std::int64_t i = first[0]; i <= last[0]; ++i)
-        for (std::int64_t j = first[1]; j <= last[1]; ++j)
-          for (std::int64_t kk = first[2]; kk <= last[2]; ++kk) {
-            const std::uint64_t bucket = bucket_of(i, j, kk, mask);
-            for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
-              consider(bucket_cells_[e]);
-          }
-    }
-    for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
-    std::sort(candidates_.begin(), candidates_.end());
-    candidates_.erase(std::unique(candidates_.begin(), candidates_.end()), candidates_.end());
-    list_cells_.insert(list_cells_.end(), candidates_.begin(), candidates_.end());
-    list_start_[p + 1] = static_cast<std::uint32_t>(list_cells_.size());
   }
+  for (std::size_t p = 0; p < nodes; ++p) list_start_[p + 1] += list_start_[p];
+  list_cells_.clear();
+  for (const std::vector<std::int32_t>& found : thread_lists_)
+    list_cells_.insert(list_cells_.end(), found.begin(), found.end());
   built_ = end_;
   listed_mark_.assign(cells, 0);
   for (const std::int32_t c : list_cells_) listed_mark_[static_cast<std::size_t>(c)] = 1;

@@ -133,7 +133,7 @@ class SelfContact {
   std::vector<Vec3> box_lo_, box_hi_;
   std::vector<std::uint32_t> bucket_start_, bucket_cells_;
   std::vector<std::int32_t> large_cells_;
-  std::vector<std::int32_t> candidates_;
+  std::vector<std::vector<std::int32_t>> thread_candidates_, thread_lists_;  // each thread's
   // Each node's candidate cells (list_cells_ from list_start_[p] to list_start_[p + 1]), found
   // with the nodes at built_.
   std::vector<std::uint32_t> list_start_;
