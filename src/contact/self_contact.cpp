@@ -253,13 +253,14 @@ void SelfContact::build_candidates(double extent_sum) {
   // any count.
   const auto threads = static_cast<std::size_t>(omp_get_max_threads());
   thread_lists_.resize(threads);
+  // Cleared here, not by each thread: a team smaller than the most threads leaves some unused.
+  for (std::vector<std::int32_t>& found : thread_lists_) found.clear();
   thread_candidates_.resize(threads);
 #pragma omp parallel
   {
     const auto me = static_cast<std::size_t>(omp_get_thread_num());
     std::vector<std::int32_t>& found = thread_lists_[me];
     std::vector<std::int32_t>& candidates = thread_candidates_[me];
-    found.clear();
     std::int64_t from[3], to[3];
 #pragma omp for schedule(static)
     for (std::size_t p = 0; p < nodes; ++p) {
@@ -388,10 +389,10 @@ void SelfContact::find_pairs() {
 
   const double t = thickness_;
   thread_pairs_.resize(static_cast<std::size_t>(omp_get_max_threads()));
+  for (std::vector<Pair>& found : thread_pairs_) found.clear();
 #pragma omp parallel
   {
     std::vector<Pair>& found = thread_pairs_[static_cast<std::size_t>(omp_get_thread_num())];
-    found.clear();
 #pragma omp for schedule(static)
     for (int l = 0; l < n; ++l)
       for (int k = 0; k < m; ++k) {
