@@ -362,9 +362,9 @@ void SelfContact::find_pairs() {
   // its box at the build grown by the thickness and the margin. Which steps rebuild changes
   // no pair: the lists only hold more cells than the test below keeps.
   // Only the cells in some node's list need their box and planes between builds: in a sheet
-  // that does not touch itself, none. The boxes, the planes and the pairs on the rank's threads,
-  // rows in static chunks; the threads' pairs joined in thread order are the pairs in row
-  // order, the same for any count.
+  // that does not touch itself, none. The boxes, the planes and the pairs on the rank's threads
+  // in static chunks; the threads' pairs joined in thread order are the pairs in row order, the
+  // same for any count.
   if (!(drift_ <= 0.5 * margin_)) {
     row_extents_.resize(static_cast<std::size_t>(n - 1));
 #pragma omp parallel for schedule(static)
@@ -593,10 +593,8 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
                     static_cast<std::size_t>(k - b.k0)] != 0);
       }
   // A pair between held nodes only moves nothing.
-  std::erase_if(pairs_, [&](Pair& q) {
-    q.stiffness = inverse_mass(q);
-    return !(q.stiffness > 0.0);
-  });
+  for (Pair& q : pairs_) q.stiffness = inverse_mass(q);
+  std::erase_if(pairs_, [](const Pair& q) { return !(q.stiffness > 0.0); });
   if (pairs_.empty()) return stats;
   separate();
   stop_approach_and_slide(dt);
