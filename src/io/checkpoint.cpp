@@ -82,13 +82,15 @@ void write_constraints(const hdf5::File& file, const Constraints& constraints, M
 
   std::vector<std::int32_t> nodes;
   std::vector<std::uint8_t> held;
-  std::vector<double> values, since, velocities;
+  std::vector<double> values, since, velocities, spins, pivots;
   for (const Constraints::NodeState& s : local) {
     nodes.insert(nodes.end(), {s.k, s.l});
     held.push_back(s.held);
     values.insert(values.end(), {s.value.x, s.value.y, s.value.z});
     since.insert(since.end(), {s.since.x, s.since.y, s.since.z});
     velocities.insert(velocities.end(), {s.velocity.x, s.velocity.y, s.velocity.z});
+    spins.insert(spins.end(), {s.spin.x, s.spin.y, s.spin.z});
+    pivots.insert(pivots.end(), {s.pivot.x, s.pivot.y, s.pivot.z});
   }
   const auto rows = static_cast<hsize_t>(count), at = static_cast<hsize_t>(offset);
   const auto all = static_cast<hsize_t>(total);
@@ -98,6 +100,8 @@ void write_constraints(const hdf5::File& file, const Constraints& constraints, M
   const Handle since_set = create_dataset(file, "/constraint_since", H5T_IEEE_F64LE, {all, 3});
   const Handle velocity_set =
       create_dataset(file, "/constraint_velocities", H5T_IEEE_F64LE, {all, 3});
+  const Handle spin_set = create_dataset(file, "/constraint_spins", H5T_IEEE_F64LE, {all, 3});
+  const Handle pivot_set = create_dataset(file, "/constraint_pivots", H5T_IEEE_F64LE, {all, 3});
   if (all == 0) return;
   write_rows(file, node_set, H5T_NATIVE_INT32, at, rows, 2, nodes.data(), "write constraints");
   write_rows(file, held_set, H5T_NATIVE_UINT8, at, rows, 1, held.data(), "write constraints");
@@ -105,6 +109,8 @@ void write_constraints(const hdf5::File& file, const Constraints& constraints, M
   write_rows(file, since_set, H5T_NATIVE_DOUBLE, at, rows, 3, since.data(), "write constraints");
   write_rows(file, velocity_set, H5T_NATIVE_DOUBLE, at, rows, 3, velocities.data(),
              "write constraints");
+  write_rows(file, spin_set, H5T_NATIVE_DOUBLE, at, rows, 3, spins.data(), "write constraints");
+  write_rows(file, pivot_set, H5T_NATIVE_DOUBLE, at, rows, 3, pivots.data(), "write constraints");
 }
 
 std::vector<Constraints::NodeState> read_constraints(const hdf5::File& file) {
@@ -121,8 +127,12 @@ std::vector<Constraints::NodeState> read_constraints(const hdf5::File& file) {
   };
   const auto since = optional("/constraint_since");
   const auto velocities = optional("/constraint_velocities");
+  // Those written before fixes could turn lack these: no node turned.
+  const auto spins = optional("/constraint_spins");
+  const auto pivots = optional("/constraint_pivots");
   if (nodes.size() != 2 * held.size() || values.size() != 3 * held.size() ||
-      since.size() != 3 * held.size() || velocities.size() != 3 * held.size())
+      since.size() != 3 * held.size() || velocities.size() != 3 * held.size() ||
+      spins.size() != 3 * held.size() || pivots.size() != 3 * held.size())
     file.fail("read constraints (lengths differ)");
   const auto vec3 = [](const std::vector<double>& v, std::size_t i) {
     return Vec3{v[3 * i], v[3 * i + 1], v[3 * i + 2]};
@@ -130,7 +140,7 @@ std::vector<Constraints::NodeState> read_constraints(const hdf5::File& file) {
   std::vector<Constraints::NodeState> states;
   for (std::size_t i = 0; i < held.size(); ++i)
     states.push_back({nodes[2 * i], nodes[2 * i + 1], held[i], vec3(values, i), vec3(since, i),
-                      vec3(velocities, i)});
+                      vec3(velocities, i), vec3(spins, i), vec3(pivots, i)});
   return states;
 }
 
@@ -246,6 +256,11 @@ std::optional<std::string> check_constraints(const std::vector<Constraints::Node
       return fmt::format("{} holds components {:#05b}, beyond the {:#05b} this scene's fixes "
                          "hold",
                          node, s.held, fixed->second);
+    if (s.turns() && s.held != 7u)
+      return node + " turns but does not hold all three components";
+    if (!(is_finite(s.spin) && is_finite(s.pivot)))
+      return fmt::format("{} turns at ({}, {}, {}) rad/s about ({}, {}, {}) m: not finite", node,
+                         s.spin.x, s.spin.y, s.spin.z, s.pivot.x, s.pivot.y, s.pivot.z);
     if (!(is_finite(s.value) && is_finite(s.since) && is_finite(s.velocity)))
       return fmt::format("{} is held at ({}, {}, {}), from t = ({}, {}, {}) s, at ({}, {}, {}) "
                          "m/s: not finite",

@@ -862,8 +862,8 @@ std::array<bool, 3> held_axes(const Entry& entry) {
 }
 
 Fix read_fix(const Table& block, const Scene& scene) {
-  block.allow(
-      {"nodes", "region", "axes", "start", "end", "start_time", "end_time", "velocity"});
+  block.allow({"nodes", "region", "axes", "start", "end", "start_time", "end_time", "velocity",
+               "angular_velocity", "center"});
   Fix fix;
   fix.nodes = read_node_set(block, scene);
   if (const auto axes = block.find("axes")) fix.axes = held_axes(*axes);
@@ -877,6 +877,24 @@ Fix read_fix(const Table& block, const Scene& scene) {
                                    "there or hold {} too",
                                    static_cast<char>('x' + c), static_cast<char>('x' + c)));
       }
+  }
+  const auto spin = block.find("angular_velocity");
+  const auto center = block.find("center");
+  if (spin) {
+    fix.angular_velocity = spin->vector3();
+    // A turn moves every component of a node: holding fewer would let the free ones drift off
+    // the circle.
+    if (!(fix.axes[0] && fix.axes[1] && fix.axes[2]))
+      spin->fail("turns the nodes it holds, which needs all three axes held; give axes = \"xyz\"");
+    if (block.find("velocity"))
+      spin->fail("give either velocity (a translation) or angular_velocity (a turn about a fixed "
+                 "axis), not both");
+    fix.center = block
+                     .require("center", "a point [x, y, z] in metres on the axis the nodes turn "
+                                        "about")
+                     .vector3();
+  } else if (center) {
+    center->fail("is the point the nodes turn about, which needs angular_velocity");
   }
   return fix;
 }

@@ -16,7 +16,7 @@ Scheme::Scheme(const StepContext& context, const Field<Vec3>& positions)
 
 void Scheme::hold(Field<Vec3>& r, Field<Vec3>& v, double fraction) const {
   context_.constraints.hold_positions(r, stage_time(fraction));
-  context_.constraints.hold_velocities(v);
+  context_.constraints.hold_velocities(v, stage_time(fraction));
 }
 
 void Scheme::begin(Field<Vec3> velocities) {

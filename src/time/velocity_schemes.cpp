@@ -21,7 +21,7 @@ void Leapfrog::start(Field<Vec3> velocities) {
   context_.dynamics.acceleration(positions_, velocity_, 0, acceleration_, normals());
   for_owned(context_.block,
             [&](int k, int l) { velocity_(k, l) -= (0.5 * dt) * acceleration_(k, l); });
-  context_.constraints.hold_velocities(velocity_);
+  context_.constraints.hold_velocities(velocity_, context_.time - 0.5 * dt);
 }
 
 std::optional<std::string> Leapfrog::advance(long step) {
@@ -46,7 +46,7 @@ std::optional<std::string> Leapfrog::advance(long step) {
       }
     });
   }
-  context_.constraints.hold_velocities(next_velocity_);
+  context_.constraints.hold_velocities(next_velocity_, context_.time + 0.5 * dt);
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) = positions_(k, l) + dt * next_velocity_(k, l);
   });
@@ -74,7 +74,7 @@ void Leapfrog::damped_springs_velocity(double c, double d) {
     acceleration_(k, l) = rhs;
     next_velocity_(k, l) = v;
   });
-  context_.constraints.hold_velocities(next_velocity_);
+  context_.constraints.hold_velocities(next_velocity_, context_.time + s);
   dynamics.solve_velocity_terms(positions_, n_field, c, d, s, acceleration_,
                                 context_.constraints.state(), next_velocity_);
 }
@@ -85,7 +85,7 @@ std::optional<std::string> Euler::advance(long step) {
   for_owned(context_.block, [&](int k, int l) {
     next_velocity_(k, l) = velocity_(k, l) + dt * acceleration_(k, l);
   });
-  context_.constraints.hold_velocities(next_velocity_);
+  context_.constraints.hold_velocities(next_velocity_, context_.end_time);
   const Field<Vec3>& drift = symplectic_ ? next_velocity_ : velocity_;
   for_owned(context_.block, [&](int k, int l) {
     next_positions_(k, l) = positions_(k, l) + dt * drift(k, l);
@@ -191,7 +191,7 @@ std::optional<std::string> VelocityVerlet::advance(long step) {
     next_velocity_(k, l) =
         velocity_(k, l) + (0.5 * dt) * (acceleration_(k, l) + next_acceleration_(k, l));
   });
-  context_.constraints.hold_velocities(next_velocity_);
+  context_.constraints.hold_velocities(next_velocity_, context_.end_time);
   return std::nullopt;
 }
 

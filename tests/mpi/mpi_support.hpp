@@ -93,6 +93,12 @@ end = 55
 nodes = [[18, 22], [5, 3]]
 axes = "x"
 start = 55
+[[fix]]
+nodes = [[30, 18], [31, 18]]
+angular_velocity = [0.0, 3.0, 0.0]
+center = [7.25, 0.0, 4.5]
+start = 25
+end = 70
 [[load]]
 region = { disk = { center = [18, 11], radius = 6 } }
 force = [0.0, 2.0, 0.3]

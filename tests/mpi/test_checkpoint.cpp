@@ -306,9 +306,10 @@ TEST_F(Restart, RefusesACheckpointWhoseContentsTheSceneCannotContinue) {
   expect_refused("/positions is [37, 24, 3], not the [37, 23, 3] of this grid");
 }
 
-// Checkpoints from before fixes could move lack /constraint_since and /constraint_velocities:
-// every fix was still then, and such a checkpoint restarts bitwise as if they held zeros (here
-// one written at step 5, before the odd grid's moving fix switches on at step 20).
+// Checkpoints from before fixes could move lack /constraint_since and /constraint_velocities,
+// and those from before they could turn /constraint_spins and /constraint_pivots: every fix was
+// still then, and such a checkpoint restarts bitwise as if they held zeros (here one written at
+// step 5, before the odd grid's moving and turning fixes switch on at steps 20 and 25).
 TEST_F(Restart, ACheckpointWithoutFixVelocitiesRestartsBitwise) {
   Scene scene = testing::odd_grid_scene(Integrator::verlet);
   Simulation uninterrupted(scene, MPI_COMM_SELF, any_scheme);
@@ -322,6 +323,8 @@ TEST_F(Restart, ACheckpointWithoutFixVelocitiesRestartsBitwise) {
     const hid_t f = H5Fopen(checkpoint().c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
     EXPECT_GE(H5Ldelete(f, "/constraint_since", H5P_DEFAULT), 0);
     EXPECT_GE(H5Ldelete(f, "/constraint_velocities", H5P_DEFAULT), 0);
+    EXPECT_GE(H5Ldelete(f, "/constraint_spins", H5P_DEFAULT), 0);
+    EXPECT_GE(H5Ldelete(f, "/constraint_pivots", H5P_DEFAULT), 0);
     EXPECT_GE(H5Fclose(f), 0);
   }
   MPI_Barrier(MPI_COMM_WORLD);

@@ -180,6 +180,56 @@ TEST(MovingFix, ARunnerDragsTheSheet) {
   EXPECT_LT(norm(sim.positions()(8, 5) - sim.positions()(0, 0)), 1.05 * diagonal);
 }
 
+// A turning fix carries its nodes round a circle about its axis whatever the forces: from the
+// step it switches on, each node is where it was then turned through ω (t − t₀) about the axis
+// through the centre (Rodrigues' formula, docs/scene-format.md "Fixes and loads"), so it stays
+// at its distance from the axis and at its height along it, and moves at ω × (r − c). A quarter
+// turn about z takes (x, y) to (−y, x) about the centre. When the window ends, a still fix later
+// in the file holds each node where the turn left it.
+TEST_P(Schemes, TurningFixCarriesItsNodesRoundItsAxis) {
+  Scene scene = flat_sheet(6, 6);
+  scene.integrator = GetParam();
+  scene.gravity = {1.0, -9.8, 0.0};
+  Fix turning = testing::fix_nodes({{0, 0}, {0, 5}});
+  turning.angular_velocity = {0.0, 0.0, 2.0};
+  turning.center = {0.5, 1.0, 0.25};
+  turning.window.start = 50;
+  turning.window.end = 150;
+  scene.fixes.push_back(turning);
+  Fix still = testing::fix_nodes({{0, 0}, {0, 5}});
+  still.window.start = 150;
+  scene.fixes.push_back(still);
+  Simulation sim(scene, MPI_COMM_SELF);
+  ASSERT_TRUE(testing::advance(sim, 50));
+  const Vec3 caught[2] = {sim.positions()(0, 0), sim.positions()(0, 5)};
+  const double caught_at = sim.time();
+  ASSERT_LT(caught[0].y, -0.01);  // it has fallen before the fix acts
+  for (int i = 0; i < 4; ++i) {
+    ASSERT_TRUE(testing::advance(sim, 25));
+    const double angle = 2.0 * (sim.time() - caught_at);
+    const double cosine = std::cos(angle), sine = std::sin(angle);
+    for (int j = 0; j < 2; ++j) {
+      const Vec3 offset = caught[j] - turning.center;
+      const Vec3 expected = turning.center + Vec3{cosine * offset.x - sine * offset.y,
+                                                  sine * offset.x + cosine * offset.y, offset.z};
+      const Vec3 r = sim.positions()(0, 5 * j);
+      EXPECT_LT(norm(r - expected), 1e-14) << "node " << j << " at step " << 50 + 25 * (i + 1);
+      const Vec3 spin_velocity = cross(turning.angular_velocity, r - turning.center);
+      // Verlet reports the held positions' difference over the last step and leapfrog its
+      // half-step velocity: both are the turn's at the step's end to within half the angle of a
+      // step, ω Δt / 2, relative. The schemes that carry velocities at the end hold them exactly.
+      const bool one_sided =
+          scene.integrator == Integrator::verlet || scene.integrator == Integrator::leapfrog;
+      EXPECT_LT(norm(sim.velocities()(0, 5 * j) - spin_velocity),
+                (one_sided ? 0.5 * 2.0 * scene.dt * 1.01 : 1e-14) * norm(spin_velocity));
+    }
+  }
+  const Vec3 left = sim.positions()(0, 5);
+  ASSERT_TRUE(testing::advance(sim, 50));
+  EXPECT_EQ(norm(sim.positions()(0, 5) - left), 0.0);
+  EXPECT_LT(sim.positions()(5, 5).y, -0.1);  // the free nodes went on falling
+}
+
 INSTANTIATE_TEST_SUITE_P(Constraints, Schemes,
                          ::testing::Values(Integrator::verlet, Integrator::leapfrog,
                                            Integrator::rk4, Integrator::velocity_verlet,

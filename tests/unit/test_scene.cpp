@@ -249,6 +249,35 @@ TEST(SceneError, FixVelocity) {
                                     HasSubstr("moves along x, which this fix does not hold")));
 }
 
+TEST(Scene, FixAngularVelocityAndCenterAreRead) {
+  SceneText text;
+  text.tail = "[[fix]]\nnodes = [[1, 1]]\nangular_velocity = [0, 0.5, 0]\ncenter = [1, 2, 3]\n";
+  const Fix fix = parse(text).fixes.at(0);
+  EXPECT_EQ(fix.angular_velocity.y, 0.5);
+  EXPECT_EQ(fix.center.z, 3.0);
+  EXPECT_EQ(norm(fix.velocity), 0.0);
+}
+
+// A turn holds all three axes about a centre it must be given, and is not combined with a
+// translation; a centre without a turn is a mistake.
+TEST(SceneError, FixAngularVelocity) {
+  SceneText text;
+  const std::string fix = "[[fix]]\nnodes = [[1, 1]]\n";
+  text.tail = fix + "angular_velocity = [0, 0, 1]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("fix[0]"), HasSubstr("center")));
+  text.tail = fix + "axes = \"xy\"\nangular_velocity = [0, 0, 1]\ncenter = [0, 0, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].angular_velocity'"),
+                                    HasSubstr("all three axes")));
+  text.tail = fix + "velocity = [1, 0, 0]\nangular_velocity = [0, 0, 1]\ncenter = [0, 0, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("key 'fix[0].angular_velocity'"),
+                                    HasSubstr("not both")));
+  text.tail = fix + "center = [0, 0, 0]\n";
+  EXPECT_THAT(error_of(text),
+              AllOf(HasSubstr("key 'fix[0].center'"), HasSubstr("needs angular_velocity")));
+  text.tail = fix + "angular_velocity = [0, nan, 1]\ncenter = [0, 0, 0]\n";
+  EXPECT_THAT(error_of(text), AllOf(HasSubstr("fix[0].angular_velocity"), HasSubstr("finite")));
+}
+
 TEST(Scene, PresetGivesEverythingAndScalesMassToTheSheet) {
   SceneText text;
   text.grid = "nodes = [5, 5]\nsize = [5.0, 4.0]\n";

@@ -58,6 +58,10 @@ struct Fix {
   // m/s: the held components move at this velocity from the moment they are held (0 on every
   // axis the fix does not hold).
   Vec3 velocity{};
+  // rad/s: the held nodes turn rigidly about the fixed axis through `center` along this vector
+  // (all three components held; no `velocity`), from where they are when held.
+  Vec3 angular_velocity{};
+  Vec3 center{};  // m
 };
 
 struct Load {
