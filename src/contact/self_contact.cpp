@@ -119,6 +119,16 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   const auto cells = static_cast<std::size_t>(block.m - 1) * static_cast<std::size_t>(block.n - 1);
   box_lo_.resize(cells);
   box_hi_.resize(cells);
+  const int m = block.m, n = block.n;
+  const int horizontal = (m - 1) * n;
+  for (int e = 0; e < horizontal; ++e) {
+    const int l = e / (m - 1);
+    if (l == 0 || l == n - 1) border_edges_.push_back(e);
+  }
+  for (int e = 0; e < m * (n - 1); ++e) {
+    const int k = e % m;
+    if (k == 0 || k == m - 1) border_edges_.push_back(horizontal + e);
+  }
 }
 
 // A node on a fixed plane's offset surface or below it (the contact meets the planes before
@@ -192,6 +202,24 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
 void SelfContact::motion(std::size_t i, const Vec3& velocity, bool held) {
   velocity_[i] = velocity;
   inverse_mass_[i] = held || on_floor(end_[i]) ? 0.0 : node_inverse_mass_[i];
+}
+
+// Edge number e's two nodes, k + m l (SelfContact::border_edges_).
+std::array<std::int32_t, 2> SelfContact::edge_nodes(std::int32_t e) const {
+  const std::int32_t m = block_->m, n = block_->n, horizontal = (m - 1) * n;
+  const std::int32_t sides = horizontal + m * (n - 1), cells = (m - 1) * (n - 1);
+  if (e < horizontal) {
+    const std::int32_t first = e % (m - 1) + m * (e / (m - 1));
+    return {first, first + 1};
+  }
+  if (e < sides) {
+    const std::int32_t first = e - horizontal;
+    return {first, first + m};
+  }
+  const std::int32_t c = (e - sides) % cells;
+  const std::int32_t n00 = c % (m - 1) + m * (c / (m - 1));
+  return e - sides < cells ? std::array<std::int32_t, 2>{n00, n00 + m + 1}
+                           : std::array<std::int32_t, 2>{n00 + 1, n00 + m};
 }
 
 // Every cell's box over the step goes into the buckets of a spatial hash whose spacing is the
@@ -308,6 +336,75 @@ void SelfContact::build_candidates(double extent_sum) {
   listed_.clear();
   for (std::size_t c = 0; c < cells; ++c)
     if (listed_mark_[c] != 0) listed_.push_back(static_cast<std::int32_t>(c));
+
+  // Each border edge meets the edges of the cells its box, grown as a node's, finds in the
+  // hash, where those edges' own boxes meet it and no node of one is a node of the other or
+  // its neighbour (a fold within a cell is the bending's, as for the nodes).
+  edge_candidates_.clear();
+  const auto mi = static_cast<std::int32_t>(m);
+  const std::int32_t horizontal = (mi - 1) * block_->n;
+  const std::int32_t diagonals = horizontal + mi * (block_->n - 1);
+  const auto cells_i = static_cast<std::int32_t>(cells);
+  auto edge_box = [&](std::int32_t edge, double grow, Vec3& lo, Vec3& hi) {
+    const auto nodes = edge_nodes(edge);
+    lo = start_[static_cast<std::size_t>(nodes[0])];
+    hi = lo;
+    for (const std::int32_t node : nodes)
+      for (const Vec3& x :
+           {start_[static_cast<std::size_t>(node)], end_[static_cast<std::size_t>(node)]})
+        for (int a = 0; a < 3; ++a) {
+          lo[a] = std::min(lo[a], x[a] - grow);
+          hi[a] = std::max(hi[a], x[a] + grow);
+        }
+  };
+  auto is_border = [&](std::int32_t edge) {
+    return std::binary_search(border_edges_.begin(), border_edges_.end(), edge);
+  };
+  std::vector<std::int32_t>& sides = thread_candidates_[0];
+  for (const std::int32_t e : border_edges_) {
+    Vec3 lo, hi;
+    edge_box(e, reach, lo, hi);
+    const auto mine = edge_nodes(e);
+    sides.clear();
+    auto consider = [&](std::size_t c) {
+      for (int a = 0; a < 3; ++a)
+        if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
+      const auto ck = static_cast<std::int32_t>(c % cells_k);
+      const auto cl = static_cast<std::int32_t>(c / cells_k);
+      const auto cell = static_cast<std::int32_t>(c);
+      for (const std::int32_t f :
+           {ck + (mi - 1) * cl, ck + (mi - 1) * (cl + 1), horizontal + ck + mi * cl,
+            horizontal + ck + 1 + mi * cl, diagonals + cell, diagonals + cells_i + cell}) {
+        if (f <= e && is_border(f)) continue;
+        bool near = false;
+        for (const std::int32_t a : mine)
+          for (const std::int32_t b : edge_nodes(f))
+            near = near || (std::abs(a % mi - b % mi) <= 1 && std::abs(a / mi - b / mi) <= 1);
+        if (near) continue;
+        Vec3 flo, fhi;
+        edge_box(f, 0.0, flo, fhi);
+        bool apart = false;
+        for (int a = 0; a < 3; ++a) apart = apart || fhi[a] < lo[a] || flo[a] > hi[a];
+        if (!apart) sides.push_back(f);
+      }
+    };
+    std::int64_t from[3], to[3];
+    if (range(lo, hi, from, to) > kMostBuckets) {
+      for (std::size_t c = 0; c < cells; ++c) consider(c);
+    } else {
+      for (std::int64_t i = from[0]; i <= to[0]; ++i)
+        for (std::int64_t j = from[1]; j <= to[1]; ++j)
+          for (std::int64_t kk = from[2]; kk <= to[2]; ++kk) {
+            const std::uint64_t bucket = bucket_of(i, j, kk, mask);
+            for (std::uint32_t at = bucket_start_[bucket]; at < bucket_start_[bucket + 1]; ++at)
+              consider(bucket_cells_[at]);
+          }
+    }
+    for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+    std::sort(sides.begin(), sides.end());
+    sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
+    for (const std::int32_t f : sides) edge_candidates_.push_back({e, f});
+  }
 }
 
 // A cell's box over the step; its largest side.
@@ -463,8 +560,11 @@ void SelfContact::find_pairs() {
                 pair_side = 1.0;
               }
             }
-            found.push_back(Pair{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2], on.a, on.b,
-                                 on.c, pair_side, 0.5, direction});
+            found.push_back(Pair{{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2]},
+                                 {1.0, -on.a, -on.b, -on.c},
+                                 pair_side,
+                                 0.5,
+                                 direction});
           }
         }
       }
@@ -472,6 +572,70 @@ void SelfContact::find_pairs() {
   pairs_.clear();
   for (const std::vector<Pair>& found : thread_pairs_)
     pairs_.insert(pairs_.end(), found.begin(), found.end());
+  find_edge_pairs();
+}
+
+// A border edge and another edge that cross over the step, or end it closer than the thickness,
+// are held the thickness apart along their common normal on the side they started on: where
+// the cloth's border slides past another part of the cloth, no node need meet a triangle, and
+// the edges would pass through each other between their nodes (docs/contact.md,
+// "Self-contact").
+void SelfContact::find_edge_pairs() {
+  const double t = thickness_;
+  const std::int32_t diagonals = (block_->m - 1) * block_->n + block_->m * (block_->n - 1);
+  // The parameters of the nearest points of the lines through a0 + s ea and b0 + u eb; false
+  // for lines so near parallel that their common normal has no direction.
+  auto nearest = [](const Vec3& a0, const Vec3& ea, const Vec3& b0, const Vec3& eb, double& s,
+                    double& u) {
+    const Vec3 w = a0 - b0;
+    const double aa = dot(ea, ea), ab = dot(ea, eb), bb = dot(eb, eb);
+    const double denominator = aa * bb - ab * ab;
+    if (!(denominator > 1e-6 * aa * bb)) return false;
+    const double d = dot(ea, w), e = dot(eb, w);
+    s = (ab * e - bb * d) / denominator;
+    u = (aa * e - ab * d) / denominator;
+    return true;
+  };
+  for (const auto& [e, f] : edge_candidates_) {
+    const auto ea = edge_nodes(e), eb = edge_nodes(f);
+    const auto a0 = static_cast<std::size_t>(ea[0]), a1 = static_cast<std::size_t>(ea[1]);
+    const auto b0 = static_cast<std::size_t>(eb[0]), b1 = static_cast<std::size_t>(eb[1]);
+    const Vec3 normal0 = cross(start_[a1] - start_[a0], start_[b1] - start_[b0]);
+    const Vec3 edge_a = end_[a1] - end_[a0], edge_b = end_[b1] - end_[b0];
+    const Vec3 normal1 = cross(edge_a, edge_b);
+    // Edges that turned through parallel in the step keep no side.
+    if (!(dot(normal0, normal1) > 0.0)) continue;
+    const double volume0 = dot(normal0, start_[a0] - start_[b0]);
+    const double volume1 = dot(normal1, end_[a0] - end_[b0]);
+    const double side = volume0 >= 0.0 ? 1.0 : -1.0;
+    const double length = norm(normal1);
+    const double d1 = side * volume1 / length;  // the lines' distance, on the starting side
+    if (d1 >= t) continue;
+    double s, u;
+    if (d1 < 0.0) {
+      // The lines met within the step (the volume passed through zero, linearly between its
+      // ends): where they met must lie within both edges, or within the thickness of them, or
+      // the edges passed beside each other.
+      const double at = volume0 / (volume0 - volume1);
+      const Vec3 p0 = lerp(start_[a0], end_[a0], at), q0 = lerp(start_[b0], end_[b0], at);
+      const Vec3 pa = lerp(start_[a1], end_[a1], at) - p0, qb = lerp(start_[b1], end_[b1], at) - q0;
+      if (!nearest(p0, pa, q0, qb, s, u)) continue;
+      const double slack_a = t / norm(pa), slack_b = t / norm(qb);
+      if (s < -slack_a || s > 1.0 + slack_a || u < -slack_b || u > 1.0 + slack_b) continue;
+    } else if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u) || !(s > 0.0 && s < 1.0) ||
+               !(u > 0.0 && u < 1.0)) {
+      // Near where the lines are, but the edges' nearest points lie beyond an end: a node near
+      // an edge, which the node's pairs with the edge's triangles hold.
+      continue;
+    }
+    if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u)) continue;
+    s = std::clamp(s, 0.0, 1.0);
+    u = std::clamp(u, 0.0, 1.0);
+    // A diagonal is one of a cell's two, each at half weight as the triangles are.
+    const double share = f >= diagonals ? 0.5 : 1.0;
+    pairs_.push_back(Pair{
+        {ea[0], ea[1], eb[0], eb[1]}, {1.0 - s, s, -(1.0 - u), -u}, side, share, normal1 / length});
+  }
 }
 
 // Σ w_i x_i over a pair's corners (SelfContact::Corners) is the node's offset from its foot, and
@@ -584,7 +748,7 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
   stats.contacts = static_cast<long>(pairs_.size());
   if (ranks_ == 1)
     for (const Pair& q : pairs_)
-      for (const std::int32_t node : {q.p, q.a, q.b, q.c}) {
+      for (const std::int32_t node : q.nodes) {
         const auto i = static_cast<std::size_t>(node);
         const int k = static_cast<int>(i % static_cast<std::size_t>(b.m));
         const int l = static_cast<int>(i / static_cast<std::size_t>(b.m));

@@ -3,6 +3,7 @@
 // of every triangle of the grid it is not a corner of where it started the step, at least the
 // cloth's thickness away, with inelastic normal velocities and Coulomb friction between layers.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -49,26 +50,28 @@ class SelfContact {
   static double memory_bytes(int m, int n) { return 800.0 * m * n; }
 
  private:
-  // A node p on one side of a cell's triangle (a, b, c), held at the thickness from it along
-  // `normal`: the triangle's at the proposed step, or from its nearest point to p where p's
-  // foot lies beside it.
+  // Two points of the grid held at the thickness apart along `normal`, each a weighted sum of
+  // nodes: a node p on one side of a cell's triangle (a, b, c), weights 1 and minus p's foot's
+  // barycentric coordinates; or a point of one border edge against a point of another, weights
+  // (1 − s, s) and −(1 − u, −u). Σ weights × positions is the first point's offset from the
+  // second.
   struct Pair {
-    std::int32_t p, a, b, c;  // global node numbers, k + m l
-    double wa, wb, wc;        // p's foot in the triangle, barycentric
-    double side;              // ±1: the side p started the step on
-    double share;             // of the cell's two diagonals
-    Vec3 normal;
+    std::int32_t nodes[4];  // global node numbers, k + m l
+    double weights[4];
+    double side;   // ±1: the side of the normal the first point started the step on
+    double share;  // of the cell's two diagonals for a node; 1 for two edges
+    Vec3 normal;   // the triangle's at the proposed step, or the edges' common normal, or the
+                   // line from the triangle's nearest point where p's foot lies beside it
     double impulse = 0.0;    // the normal velocity impulse it gave, per unit of mass
     double stiffness = 0.0;  // the inverse of the mass it moves as one (inverse_mass)
   };
-  // A pair's node with weight 1 and its triangle's corners with minus their barycentric
-  // weights.
   struct Corners {
     std::int32_t nodes[4];
     double weights[4];
   };
   static Corners corners(const Pair& q) {
-    return {{q.p, q.a, q.b, q.c}, {1.0, -q.wa, -q.wb, -q.wc}};
+    return {{q.nodes[0], q.nodes[1], q.nodes[2], q.nodes[3]},
+            {q.weights[0], q.weights[1], q.weights[2], q.weights[3]}};
   }
 
   bool gather(const Field<Vec3>& current, const Field<Vec3>& next,
@@ -80,6 +83,7 @@ class SelfContact {
   void cell_planes(std::size_t c);
   void build_candidates(double extent_sum);
   void find_pairs();
+  void find_edge_pairs();
   Vec3 across(const Pair& q, const std::vector<Vec3>& x) const;
   double inverse_mass(const Pair& q) const;
   void share_out(const Pair& q, double amount, double sign, const Vec3& direction,
@@ -144,6 +148,16 @@ class SelfContact {
   // needs.
   std::vector<std::int32_t> listed_;
   std::vector<char> listed_mark_;
+
+  // The cloth's border edges, whose crossings no node meets, against every edge of the grid:
+  // edges are numbered (k, l)–(k + 1, l) as k + (m − 1) l, then (k, l)–(k, l + 1) as
+  // (m − 1) n + k + m l, then each cell c's diagonals from (k, l) and from (k + 1, l), after
+  // those, as c and (m − 1)(n − 1) + c. The border edges in increasing number, and the pairs of a
+  // border edge and another edge, nodes more than one apart, whose boxes met at the last build (a
+  // pair of border edges once, the lower number first).
+  std::array<std::int32_t, 2> edge_nodes(std::int32_t edge) const;
+  std::vector<std::int32_t> border_edges_;
+  std::vector<std::array<std::int32_t, 2>> edge_candidates_;
 };
 
 }  // namespace cosserat
