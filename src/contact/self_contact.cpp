@@ -71,6 +71,19 @@ std::uint64_t bucket_of(std::int64_t i, std::int64_t j, std::int64_t k, std::uin
   return h & mask;
 }
 
+// The sign of the volume of (a, b, c, d): which side of the plane through a, b, c d lies on.
+int orient(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d) {
+  const double volume = dot(cross(b - a, c - a), d - a);
+  return (volume > 0.0) - (volume < 0.0);
+}
+
+// Whether the segment pq passes through the triangle abc (touching not counted).
+bool through(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c) {
+  if (orient(a, b, c, p) * orient(a, b, c, q) >= 0) return false;
+  const int s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
+  return s1 != 0 && s1 == s2 && s2 == s3;
+}
+
 }  // namespace
 
 SelfContact::SelfContact(double thickness, double friction, double spacing, const Block& block,
@@ -220,6 +233,36 @@ std::array<std::int32_t, 2> SelfContact::edge_nodes(std::int32_t e) const {
   const std::int32_t n00 = c % (m - 1) + m * (c / (m - 1));
   return e - sides < cells ? std::array<std::int32_t, 2>{n00, n00 + m + 1}
                            : std::array<std::int32_t, 2>{n00 + 1, n00 + m};
+}
+
+// The cells edge number e bounds (−1: none beyond the border).
+std::array<std::int32_t, 2> SelfContact::edge_cells(std::int32_t e) const {
+  const std::int32_t m = block_->m, n = block_->n, horizontal = (m - 1) * n;
+  const std::int32_t sides = horizontal + m * (n - 1), cells = (m - 1) * (n - 1);
+  if (e < horizontal) {
+    const std::int32_t k = e % (m - 1), l = e / (m - 1);
+    return {l > 0 ? k + (m - 1) * (l - 1) : -1, l < n - 1 ? k + (m - 1) * l : -1};
+  }
+  if (e < sides) {
+    const std::int32_t k = (e - horizontal) % m, l = (e - horizontal) / m;
+    return {k > 0 ? k - 1 + (m - 1) * l : -1, k < m - 1 ? k + (m - 1) * l : -1};
+  }
+  return {(e - sides) % cells, -1};
+}
+
+// Whether, at the step's start, the segment between nodes p and q passes through one of cell
+// c's four triangles.
+bool SelfContact::through_cell(std::int32_t p, std::int32_t q, std::int32_t c) const {
+  if (c < 0) return false;
+  const std::int32_t m = block_->m;
+  const auto n00 = static_cast<std::size_t>(c % (m - 1) + m * (c / (m - 1)));
+  const auto n10 = n00 + 1, n01 = n00 + static_cast<std::size_t>(m), n11 = n01 + 1;
+  const Vec3 &a = start_[static_cast<std::size_t>(p)], &b = start_[static_cast<std::size_t>(q)];
+  const std::size_t triangles[4][3] = {
+      {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
+  for (const auto& tri : triangles)
+    if (through(a, b, start_[tri[0]], start_[tri[1]], start_[tri[2]])) return true;
+  return false;
 }
 
 // Every cell's box over the step goes into the buckets of a spatial hash whose spacing is the
@@ -628,6 +671,13 @@ void SelfContact::find_edge_pairs() {
       // an edge, which the node's pairs with the edge's triangles hold.
       continue;
     }
+    // Edges that start the step with one through a cell of the other are tangled already (from
+    // before self-contact was on, a fix that drove them through, or passes that did not
+    // converge): held on the sides they start on, the tangle could never come undone.
+    const auto cells_a = edge_cells(e), cells_b = edge_cells(f);
+    if (through_cell(ea[0], ea[1], cells_b[0]) || through_cell(ea[0], ea[1], cells_b[1]) ||
+        through_cell(eb[0], eb[1], cells_a[0]) || through_cell(eb[0], eb[1], cells_a[1]))
+      continue;
     if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u)) continue;
     s = std::clamp(s, 0.0, 1.0);
     u = std::clamp(u, 0.0, 1.0);

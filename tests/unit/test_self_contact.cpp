@@ -95,6 +95,52 @@ TEST(SelfContact, ATriangleTurnedOverInAStepThrowsNoNode) {
   EXPECT_LE(highest, 1.01 * thickness);
 }
 
+// Two border edges crossed like the bars of an X, 4 mm apart in a step where the thickness is
+// 1 mm: edge B, (4, 1)–(5, 1) along z, drops at 40 m/s through edge A, (0, 0)–(1, 0) along x.
+// A strip of 6 × 2 nodes with no stiffness holds them: A's cell hangs below it in the plane
+// z = 0, B's stands above it in x = 0, and the cells between reach far away, so no node comes
+// within 5 cm of a triangle and only the edges meet. Without self-contact B ends 2 mm below
+// A; with it, B's middle ends at least the thickness above A's (the crossing found from the
+// lines' signed volume; before border edges met other edges B went through, checked).
+TEST(SelfContact, ABorderEdgeDoesNotPassThroughAnother) {
+  const double thickness = 1e-3, dt = 1e-4;
+  const Vec3 drop{0.0, -40.0, 0.0};
+  const Vec3 at[6][2] = {{{-0.05, 0.0, 0.0}, {-0.05, -0.1, 0.0}},
+                         {{0.05, 0.0, 0.0}, {0.05, -0.1, 0.0}},
+                         {{1.0, 0.0, 0.0}, {1.0, -0.1, 0.0}},
+                         {{1.0, 0.1, -0.5}, {1.0, 0.002, -0.5}},
+                         {{0.0, 0.1, -0.05}, {0.0, 0.002, -0.05}},
+                         {{0.0, 0.1, 0.05}, {0.0, 0.002, 0.05}}};
+  for (const bool on : {false, true}) {
+    Scene s = testing::flat_sheet(6, 2);
+    s.size1 = 0.5;
+    s.size2 = 0.1;
+    s.material.mass = 0.1;
+    s.material.zeta = {0.0, 0.0, 0.0};
+    s.material.xi = {0.0, 0.0, 0.0};
+    s.material.phi = {0.0, 0.0, 0.0};
+    s.material.thickness = thickness;
+    if (on) s.self_contact = SelfContactSpec{thickness, 0.3};
+    s.dt = dt;
+    Simulation sim(s, MPI_COMM_SELF);
+    Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
+    Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+    for (int k = 0; k < 6; ++k)
+      for (int l = 0; l < 2; ++l) {
+        r(k, l) = at[k][l];
+        before(k, l) = at[k][l] - (k >= 4 && l == 1 ? dt * drop : Vec3{});
+      }
+    sim.stepper().resume(0);
+    ASSERT_FALSE(sim.step());
+    const Field<Vec3>& x = sim.positions();
+    const double b_over_a = 0.5 * (x(4, 1).y + x(5, 1).y) - 0.5 * (x(0, 0).y + x(1, 0).y);
+    if (on)
+      EXPECT_GE(b_over_a, 0.999 * thickness);
+    else
+      EXPECT_LT(b_over_a, -0.0019) << "the control must pass through";
+  }
+}
+
 struct Energies {
   double total;
   double kinetic;

@@ -156,6 +156,8 @@ class SelfContact {
   // border edge and another edge, nodes more than one apart, whose boxes met at the last build (a
   // pair of border edges once, the lower number first).
   std::array<std::int32_t, 2> edge_nodes(std::int32_t edge) const;
+  std::array<std::int32_t, 2> edge_cells(std::int32_t edge) const;
+  bool through_cell(std::int32_t p, std::int32_t q, std::int32_t cell) const;
   std::vector<std::int32_t> border_edges_;
   std::vector<std::array<std::int32_t, 2>> edge_candidates_;
 };
