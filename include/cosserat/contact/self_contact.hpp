@@ -153,7 +153,7 @@ class SelfContact {
   // edges are numbered (k, l)–(k + 1, l) as k + (m − 1) l, then (k, l)–(k, l + 1) as
   // (m − 1) n + k + m l, then each cell c's diagonals from (k, l) and from (k + 1, l), after
   // those, as c and (m − 1)(n − 1) + c. The border edges in increasing number, and the pairs of a
-  // border edge and another edge, nodes more than one apart, whose boxes met at the last build (a
+  // border edge and another edge, nodes more than two apart, whose boxes met at the last build (a
   // pair of border edges once, the lower number first).
   std::array<std::int32_t, 2> edge_nodes(std::int32_t edge) const;
   std::array<std::int32_t, 2> edge_cells(std::int32_t edge) const;
