@@ -317,6 +317,24 @@ void SelfContact::build_candidates(double extent_sum) {
     }
   }
 
+  // Calls consider(c) for every cell c in the buckets the box from lo to hi covers (some more
+  // than once), or for every cell where it covers too many, and for every large cell.
+  auto each_cell_near = [&](const Vec3& lo, const Vec3& hi, auto&& consider) {
+    std::int64_t from[3], to[3];
+    if (range(lo, hi, from, to) > kMostBuckets) {
+      for (std::size_t c = 0; c < cells; ++c) consider(c);
+    } else {
+      for (std::int64_t i = from[0]; i <= to[0]; ++i)
+        for (std::int64_t j = from[1]; j <= to[1]; ++j)
+          for (std::int64_t kk = from[2]; kk <= to[2]; ++kk) {
+            const std::uint64_t bucket = bucket_of(i, j, kk, mask);
+            for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
+              consider(bucket_cells_[e]);
+          }
+    }
+    for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+  };
+
   const double reach = thickness_ + margin_;
   list_start_.assign(nodes + 1, 0);
   // Each thread lists a static chunk of the nodes, counting each node's cells into
@@ -332,7 +350,6 @@ void SelfContact::build_candidates(double extent_sum) {
     const auto me = static_cast<std::size_t>(omp_get_thread_num());
     std::vector<std::int32_t>& found = thread_lists_[me];
     std::vector<std::int32_t>& candidates = thread_candidates_[me];
-    std::int64_t from[3], to[3];
 #pragma omp for schedule(static)
     for (std::size_t p = 0; p < nodes; ++p) {
       Vec3 lo = start_[p], hi = lo;
@@ -351,18 +368,7 @@ void SelfContact::build_candidates(double extent_sum) {
         if ((dk == 0 || dk == -1) && (dl == 0 || dl == -1)) return;
         candidates.push_back(static_cast<std::int32_t>(c));
       };
-      if (range(lo, hi, from, to) > kMostBuckets) {
-        for (std::size_t c = 0; c < cells; ++c) consider(c);
-      } else {
-        for (std::int64_t i = from[0]; i <= to[0]; ++i)
-          for (std::int64_t j = from[1]; j <= to[1]; ++j)
-            for (std::int64_t kk = from[2]; kk <= to[2]; ++kk) {
-              const std::uint64_t bucket = bucket_of(i, j, kk, mask);
-              for (std::uint32_t e = bucket_start_[bucket]; e < bucket_start_[bucket + 1]; ++e)
-                consider(bucket_cells_[e]);
-            }
-      }
-      for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+      each_cell_near(lo, hi, consider);
       std::sort(candidates.begin(), candidates.end());
       candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
       found.insert(found.end(), candidates.begin(), candidates.end());
@@ -434,19 +440,7 @@ void SelfContact::build_candidates(double extent_sum) {
         if (!apart) sides.push_back(f);
       }
     };
-    std::int64_t from[3], to[3];
-    if (range(lo, hi, from, to) > kMostBuckets) {
-      for (std::size_t c = 0; c < cells; ++c) consider(c);
-    } else {
-      for (std::int64_t i = from[0]; i <= to[0]; ++i)
-        for (std::int64_t j = from[1]; j <= to[1]; ++j)
-          for (std::int64_t kk = from[2]; kk <= to[2]; ++kk) {
-            const std::uint64_t bucket = bucket_of(i, j, kk, mask);
-            for (std::uint32_t at = bucket_start_[bucket]; at < bucket_start_[bucket + 1]; ++at)
-              consider(bucket_cells_[at]);
-          }
-    }
-    for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
+    each_cell_near(lo, hi, consider);
     std::sort(sides.begin(), sides.end());
     sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
     for (const std::int32_t f : sides) edge_candidates_.push_back({e, f});
