@@ -19,7 +19,8 @@ namespace cosserat {
 
 // What one step's response found; the same on every rank.
 struct SelfContactStats {
-  long contacts = 0;  // node-triangle pairs closer than the thickness before the response
+  // Node–triangle and edge–edge pairs closer than the thickness, or crossed, before the response.
+  long contacts = 0;
   // The smallest distance of a pair it held, after the response, m (infinite: none).
   double closest = std::numeric_limits<double>::infinity();
 };
