@@ -1,6 +1,7 @@
 #pragma once
 // The cloth against its own cells (docs/contact.md, "Self-contact"): a node is kept on the side
-// of every triangle of the grid it is not a corner of where it started the step, at least the
+// of every triangle of the grid outside its own four cells where it started the step, and an
+// edge of the cloth's border on the side of every edge more than two nodes away, at least the
 // cloth's thickness away, with inelastic normal velocities and Coulomb friction between layers.
 
 #include <array>
