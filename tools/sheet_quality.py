@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Quality of a sheet's shape in the frames of a run (issue 11, item 5).
 
-    /usr/bin/python3 tools/sheet_quality.py OUT.h5 [--json] [--every N]
+    /usr/bin/python3 tools/sheet_quality.py OUT.h5 [--json] [--every N] [--thickness T]
 
 Per frame, from /positions [frames, m, n, 3] (node [k, l] at [f, k, l, :], docs/output.md):
 
@@ -17,7 +17,9 @@ Per frame, from /positions [frames, m, n, 3] (node [k, l] at [f, k, l, :], docs/
               distance is below h/2, h the smallest rest spacing (from frame 0); and the
               smallest distance / h of such far-apart pairs within h (none within h: blank).
               Found with a uniform grid of bins of size h (numpy), so a 120 x 120 sheet over a
-              hundred frames takes seconds.
+              hundred frames takes seconds. With --thickness T (metres, below h), also those
+              closer than T/2 ("pairs<t/2"): self-contact keeps its layers T apart
+              (docs/contact.md, "Self-contact").
   crossed     pairs of the sheet's triangles (area()'s two a cell, pairs sharing a node left
               out) that pass through each other, by an exact test: in general position two
               triangles intersect when an edge of one passes through the other, decided by
@@ -103,13 +105,14 @@ def bin_pairs(points, size):
                 yield i, order[np.arange(total) + np.repeat(lo - np.cumsum(sizes) + sizes, sizes)]
 
 
-def proximity(r, h):
+def proximity(r, h, thickness=None):
     """Pairs (i < j) with Chebyshev index distance > FAR closer than h: (count below h/2,
-    smallest distance / h or None)."""
+    smallest distance / h or None, count below thickness/2 or None without a thickness, which
+    must be below h)."""
     m, n, _ = r.shape
     pts = r.reshape(-1, 3)
     kk, ll = np.divmod(np.arange(m * n), n)
-    count, best = 0, math.inf
+    count, thin, best = 0, 0, math.inf
     for i, j in bin_pairs(pts, h):
         keep = (i < j) & (np.maximum(abs(kk[i] - kk[j]), abs(ll[i] - ll[j])) > FAR)
         if not keep.any():
@@ -117,9 +120,11 @@ def proximity(r, h):
         i, j = i[keep], j[keep]
         d = np.linalg.norm(pts[i] - pts[j], axis=-1)
         count += int((d < 0.5 * h).sum())
+        if thickness is not None:
+            thin += int((d < 0.5 * thickness).sum())
         best = min(best, float(d.min()))
     ratio = best / h if best < h else None
-    return count, ratio
+    return count, ratio, (thin if thickness is not None else None)
 
 
 def orient(a, b, c, d):
@@ -212,7 +217,7 @@ def zigzag(r):
     return amplitude, high / (high + low)
 
 
-def analyse(path, every=1):
+def analyse(path, every=1, thickness=None):
     with h5py.File(path, "r") as f:
         pos = f["/positions"]
         times = f["/time"][:]
@@ -243,7 +248,7 @@ def analyse(path, every=1):
                           float(cos_l.min()) if cos_l.size else 1.0)
             finite = bool(np.isfinite(r).all())
             zz_amp, zz_frac = zigzag(r) if finite else (None, None)
-            pairs, dmin = proximity(r, h) if finite else (None, None)
+            pairs, dmin, thin = proximity(r, h, thickness) if finite else (None, None, None)
             crossed, crossed_cells = crossings(r) if finite else (None, None)
             out.append({
                 "frame": fi, "step": int(steps[fi]), "time": float(times[fi]),
@@ -252,6 +257,7 @@ def analyse(path, every=1):
                 "inverted_cells": int((sign < 0).sum()),
                 "min_normal_cos": min_cos,
                 "close_pairs": pairs, "min_far_distance_over_h": dmin,
+                "pairs_below_half_thickness": thin,
                 "crossing_pairs": crossed, "crossing_cells": crossed_cells,
                 "area_ratio": area(r) / area0,
                 "zigzag_amplitude": zz_amp, "zigzag_fraction": zz_frac,
@@ -270,6 +276,7 @@ def analyse(path, every=1):
     overall = {"status": status, "frames": len(out)}
     for key, fn in (("min_det_ratio", min), ("min_signed_det_ratio", min),
                     ("inverted_cells", max), ("min_normal_cos", min), ("close_pairs", max),
+                    ("pairs_below_half_thickness", max),
                     ("crossing_pairs", max), ("crossing_cells", max),
                     ("min_far_distance_over_h", min), ("area_ratio", min),
                     ("zigzag_amplitude", max), ("zigzag_fraction", max)):
@@ -278,8 +285,8 @@ def analyse(path, every=1):
         overall[key + "_time"] = t
     overall["max_area_ratio"] = max(fr["area_ratio"] for fr in out)
     overall["final_area_ratio"] = out[-1]["area_ratio"]
-    return {"file": path, "grid": list(rest.shape[:2]), "h": h, "frames": out,
-            "overall": overall}
+    return {"file": path, "grid": list(rest.shape[:2]), "h": h, "thickness": thickness,
+            "frames": out, "overall": overall}
 
 
 def fmt(v, spec):
@@ -291,8 +298,11 @@ def main():
     ap.add_argument("h5")
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     ap.add_argument("--every", type=int, default=1, help="analyse every N-th frame (and the last)")
+    ap.add_argument("--thickness", type=float,
+                    help="the cloth's thickness t, m: also count the pairs closer than t/2")
     args = ap.parse_args()
-    res = analyse(args.h5, max(1, args.every))
+    res = analyse(args.h5, max(1, args.every), args.thickness)
+    thin = args.thickness is not None
     if args.json:
         json.dump(res, sys.stdout)
         print()
@@ -301,14 +311,15 @@ def main():
           f"status {res['overall']['status'] or '?'}")
     print(f"{'frame':>5} {'time':>8} {'det a/A':>9} {'signed':>9} {'inv':>4} {'min cos':>8} "
           f"{'pairs<h/2':>9} {'dmin/h':>7} {'crossed':>7} {'S/S0':>7} {'zz amp':>8} "
-          f"{'zz frac':>7}")
+          f"{'zz frac':>7}" + (f" {'pairs<t/2':>9}" if thin else ""))
     for fr in res["frames"]:
         print(f"{fr['frame']:5d} {fr['time']:8.3f} {fr['min_det_ratio']:9.3g} "
               f"{fr['min_signed_det_ratio']:9.3g} {fr['inverted_cells']:4d} "
               f"{fr['min_normal_cos']:8.3f} {fmt(fr['close_pairs'], '9d')} "
               f"{fmt(fr['min_far_distance_over_h'], '7.3f')} {fmt(fr['crossing_pairs'], '7d')} "
               f"{fr['area_ratio']:7.4f} "
-              f"{fmt(fr['zigzag_amplitude'], '8.2e')} {fmt(fr['zigzag_fraction'], '7.3f')}")
+              f"{fmt(fr['zigzag_amplitude'], '8.2e')} {fmt(fr['zigzag_fraction'], '7.3f')}"
+              + (f" {fmt(fr['pairs_below_half_thickness'], '9d')}" if thin else ""))
     o = res["overall"]
     print(f"overall: det a/A {o['min_det_ratio']:.3g} (t {o['min_det_ratio_time']:.3f}), signed "
           f"{o['min_signed_det_ratio']:.3g}, most inverted cells {o['inverted_cells']}, min cos "
@@ -318,7 +329,8 @@ def main():
           f"{fmt(o['crossing_cells'], 'd')} cells), "
           f"S/S0 {o['area_ratio']:.4f}..{o['max_area_ratio']:.4f} (final "
           f"{o['final_area_ratio']:.4f}), zig-zag amplitude up to "
-          f"{fmt(o['zigzag_amplitude'], '.2e')} m, share up to {fmt(o['zigzag_fraction'], '.3f')}")
+          f"{fmt(o['zigzag_amplitude'], '.2e')} m, share up to {fmt(o['zigzag_fraction'], '.3f')}"
+          + (f", most pairs<t/2 {fmt(o['pairs_below_half_thickness'], 'd')}" if thin else ""))
 
 
 if __name__ == "__main__":

@@ -93,5 +93,20 @@ class Crossings(unittest.TestCase):
         self.assertGreater(cells, 0)
 
 
+class Proximity(unittest.TestCase):
+    def test_layers_closer_than_half_the_thickness_are_counted(self):
+        # The U's layers 1 mm apart (h = 0.1 m): every node of the upper half more than 3 rows
+        # from the fold lies over one of the lower half, 1 mm away: below half of t = 3 mm,
+        # not below half of t = 1.5 mm; without a thickness, no count.
+        m, n = 11, 21
+        r = folded(m, n, lambda d: 0.001 + 0.0 * d)
+        over = sum(1 for l in range(n // 2 + 1, n) if (l - (n - 1 - l)) > 3) * m
+        below_h, _, none = sheet_quality.proximity(r, 0.1)
+        self.assertIsNone(none)
+        self.assertEqual(sheet_quality.proximity(r, 0.1, 0.003)[2], over)
+        self.assertEqual(sheet_quality.proximity(r, 0.1, 0.0015)[2], 0)
+        self.assertGreaterEqual(below_h, over)
+
+
 if __name__ == "__main__":
     unittest.main()
