@@ -250,18 +250,23 @@ std::array<std::int32_t, 2> SelfContact::edge_cells(std::int32_t e) const {
   return {(e - sides) % cells, -1};
 }
 
+// Both diagonals, each at half weight: no diagonal is preferred (docs/contact.md, "Symmetry").
+SelfContact::Triangles SelfContact::cell_triangles(std::int32_t cell) const {
+  const std::int32_t m = block_->m;
+  const std::int32_t n00 = cell % (m - 1) + m * (cell / (m - 1));
+  const std::int32_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
+  return {{{n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}}};
+}
+
 // Whether, at the step's start, the segment between nodes p and q passes through one of cell
 // c's four triangles.
 bool SelfContact::through_cell(std::int32_t p, std::int32_t q, std::int32_t c) const {
   if (c < 0) return false;
-  const std::int32_t m = block_->m;
-  const auto n00 = static_cast<std::size_t>(c % (m - 1) + m * (c / (m - 1)));
-  const auto n10 = n00 + 1, n01 = n00 + static_cast<std::size_t>(m), n11 = n01 + 1;
   const Vec3 &a = start_[static_cast<std::size_t>(p)], &b = start_[static_cast<std::size_t>(q)];
-  const std::size_t triangles[4][3] = {
-      {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
-  for (const auto& tri : triangles)
-    if (through(a, b, start_[tri[0]], start_[tri[1]], start_[tri[2]])) return true;
+  for (const auto& tri : cell_triangles(c))
+    if (through(a, b, start_[static_cast<std::size_t>(tri[0])],
+                start_[static_cast<std::size_t>(tri[1])], start_[static_cast<std::size_t>(tri[2])]))
+      return true;
   return false;
 }
 
@@ -466,16 +471,14 @@ double SelfContact::cell_box(std::size_t c) {
 // A cell's four triangles' planes at both ends of the step, in the order of find_pairs'
 // triangles.
 void SelfContact::cell_planes(std::size_t c) {
-  const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
-  const std::size_t n00 = c % cells_k + m * (c / cells_k);
-  const std::size_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
-  const std::size_t triangles[4][3] = {
-      {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
-  for (int j = 0; j < 4; ++j) {
-    const auto& tri = triangles[j];
-    Plane& plane = planes_[4 * c + static_cast<std::size_t>(j)];
-    const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
-    const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
+  const Triangles triangles = cell_triangles(static_cast<std::int32_t>(c));
+  for (std::size_t j = 0; j < 4; ++j) {
+    const auto a = static_cast<std::size_t>(triangles[j][0]);
+    const auto b = static_cast<std::size_t>(triangles[j][1]);
+    const auto d = static_cast<std::size_t>(triangles[j][2]);
+    Plane& plane = planes_[4 * c + j];
+    const Vec3 &a0 = start_[a], &b0 = start_[b], &c0 = start_[d];
+    const Vec3 &a1 = end_[a], &b1 = end_[b], &c1 = end_[d];
     plane.normal0 = cross(b0 - a0, c0 - a0);
     const Vec3 normal1 = cross(b1 - a1, c1 - a1);
     plane.area0 = norm(plane.normal0);
@@ -546,13 +549,7 @@ void SelfContact::find_pairs() {
           for (int a = 0; a < 3; ++a)
             apart = apart || box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a];
           if (apart) continue;
-          const int ck = c % cells_k, cl = c / cells_k;
-          const auto n00 = static_cast<std::int32_t>(ck + m * cl);
-          const std::int32_t n10 = n00 + 1, n01 = n00 + m, n11 = n01 + 1;
-          // Both diagonals, each at half weight: no diagonal is preferred (docs/contact.md,
-          // "Symmetry").
-          const std::int32_t triangles[4][3] = {
-              {n00, n10, n11}, {n00, n11, n01}, {n00, n10, n01}, {n10, n11, n01}};
+          const Triangles triangles = cell_triangles(c);
           for (int j = 0; j < 4; ++j) {
             const auto& tri = triangles[j];
             const Plane& plane =
@@ -651,7 +648,9 @@ void SelfContact::find_edge_pairs() {
     const double length = norm(normal1);
     const double d1 = side * volume1 / length;  // the lines' distance, on the starting side
     if (d1 >= t) continue;
+    // The lines' nearest points at the step's end, which the pair holds apart.
     double s, u;
+    if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u)) continue;
     if (d1 < 0.0) {
       // The lines met within the step (the volume passed through zero, linearly between its
       // ends): where they met must lie within both edges, or within the thickness of them, or
@@ -659,11 +658,12 @@ void SelfContact::find_edge_pairs() {
       const double at = volume0 / (volume0 - volume1);
       const Vec3 p0 = lerp(start_[a0], end_[a0], at), q0 = lerp(start_[b0], end_[b0], at);
       const Vec3 pa = lerp(start_[a1], end_[a1], at) - p0, qb = lerp(start_[b1], end_[b1], at) - q0;
-      if (!nearest(p0, pa, q0, qb, s, u)) continue;
+      double s_met, u_met;
+      if (!nearest(p0, pa, q0, qb, s_met, u_met)) continue;
       const double slack_a = t / norm(pa), slack_b = t / norm(qb);
-      if (s < -slack_a || s > 1.0 + slack_a || u < -slack_b || u > 1.0 + slack_b) continue;
-    } else if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u) || !(s > 0.0 && s < 1.0) ||
-               !(u > 0.0 && u < 1.0)) {
+      if (s_met < -slack_a || s_met > 1.0 + slack_a || u_met < -slack_b || u_met > 1.0 + slack_b)
+        continue;
+    } else if (!(s > 0.0 && s < 1.0) || !(u > 0.0 && u < 1.0)) {
       // Near where the lines are, but the edges' nearest points lie beyond an end: a node near
       // an edge, which the node's pairs with the edge's triangles hold.
       continue;
@@ -675,7 +675,6 @@ void SelfContact::find_edge_pairs() {
     if (through_cell(ea[0], ea[1], cells_b[0]) || through_cell(ea[0], ea[1], cells_b[1]) ||
         through_cell(eb[0], eb[1], cells_a[0]) || through_cell(eb[0], eb[1], cells_a[1]))
       continue;
-    if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u)) continue;
     s = std::clamp(s, 0.0, 1.0);
     u = std::clamp(u, 0.0, 1.0);
     // A diagonal is one of a cell's two, each at half weight as the triangles are.
@@ -685,20 +684,18 @@ void SelfContact::find_edge_pairs() {
   }
 }
 
-// Σ w_i x_i over a pair's corners (SelfContact::Corners) is the node's offset from its foot, and
-// Σ w_i² / m_i the inverse of the mass the pair moves as one.
+// Σ w_i x_i over a pair's nodes is the first point's offset from the second, and Σ w_i² / m_i
+// the inverse of the mass the pair moves as one.
 Vec3 SelfContact::across(const Pair& q, const std::vector<Vec3>& x) const {
-  const Corners c = corners(q);
   Vec3 sum{};
-  for (int i = 0; i < 4; ++i) sum += c.weights[i] * x[static_cast<std::size_t>(c.nodes[i])];
+  for (int i = 0; i < 4; ++i) sum += q.weights[i] * x[static_cast<std::size_t>(q.nodes[i])];
   return sum;
 }
 
 double SelfContact::inverse_mass(const Pair& q) const {
-  const Corners c = corners(q);
   double sum = 0.0;
   for (int i = 0; i < 4; ++i)
-    sum += c.weights[i] * c.weights[i] * inverse_mass_[static_cast<std::size_t>(c.nodes[i])];
+    sum += q.weights[i] * q.weights[i] * inverse_mass_[static_cast<std::size_t>(q.nodes[i])];
   return sum;
 }
 
@@ -707,13 +704,12 @@ double SelfContact::inverse_mass(const Pair& q) const {
 // share in the pair.
 void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec3& direction,
                             std::vector<Vec3>& sums) {
-  const Corners c = corners(q);
   for (int i = 0; i < 4; ++i) {
-    const auto node = static_cast<std::size_t>(c.nodes[i]);
-    if (share_[node] == 0.0) pending_.push_back(c.nodes[i]);
-    sums[node] += (q.share * amount * c.weights[i] * inverse_mass_[node] * sign) * direction;
-    share_[node] += q.share * std::abs(c.weights[i]);
-    if (touched_[node] == 0) moved_.push_back(c.nodes[i]);
+    const auto node = static_cast<std::size_t>(q.nodes[i]);
+    if (share_[node] == 0.0) pending_.push_back(q.nodes[i]);
+    sums[node] += (q.share * amount * q.weights[i] * inverse_mass_[node] * sign) * direction;
+    share_[node] += q.share * std::abs(q.weights[i]);
+    if (touched_[node] == 0) moved_.push_back(q.nodes[i]);
     touched_[node] = 1;
   }
 }

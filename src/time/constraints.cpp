@@ -10,6 +10,11 @@ namespace {
 // Node s's held components to their held value at `time`.
 void hold(const Constraints::NodeState& s, Field<Vec3>& positions, double time) {
   Vec3& r = positions(s.k, s.l);
+  // A turning node holds all three components: one turn for the three.
+  if (s.turns()) {
+    r = s.turned(time);
+    return;
+  }
   for (int c = 0; c < 3; ++c)
     if (s.held & (1u << c)) r[c] = s.position(c, time);
 }
@@ -81,8 +86,12 @@ void Constraints::hold_velocities(Field<Vec3>& velocities, double time) const {
   for (const HeldNode& node : nodes_) {
     const NodeState& s = node.state;
     Vec3& v = velocities(s.k, s.l);
+    if (s.turns()) {
+      v = cross(s.spin, s.turned(time) - s.pivot);
+      continue;
+    }
     for (int c = 0; c < 3; ++c)
-      if (s.held & (1u << c)) v[c] = s.speed(c, time);
+      if (s.held & (1u << c)) v[c] = s.velocity[c];
   }
 }
 

@@ -67,14 +67,10 @@ class SelfContact {
     double impulse = 0.0;    // the normal velocity impulse it gave, per unit of mass
     double stiffness = 0.0;  // the inverse of the mass it moves as one (inverse_mass)
   };
-  struct Corners {
-    std::int32_t nodes[4];
-    double weights[4];
-  };
-  static Corners corners(const Pair& q) {
-    return {{q.nodes[0], q.nodes[1], q.nodes[2], q.nodes[3]},
-            {q.weights[0], q.weights[1], q.weights[2], q.weights[3]}};
-  }
+  // A cell's four triangles, node numbers k + m l: both diagonals' pairs, in the order of its
+  // planes (planes_).
+  using Triangles = std::array<std::array<std::int32_t, 3>, 4>;
+  Triangles cell_triangles(std::int32_t cell) const;
 
   bool gather(const Field<Vec3>& current, const Field<Vec3>& next,
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,

@@ -42,14 +42,11 @@ class Constraints {
     Vec3 pivot{};     // m
 
     bool turns() const { return spin.x != 0.0 || spin.y != 0.0 || spin.z != 0.0; }
-    // Where held component c is at `time` / how fast it moves then: functions of the node and
-    // time alone, so the same on every decomposition and after a restart.
+    // Where held component c is at `time`: a function of the node and time alone, so the same
+    // on every decomposition and after a restart.
     double position(int c, double time) const {
       if (turns()) return turned(time)[c];
       return velocity[c] == 0.0 ? value[c] : value[c] + velocity[c] * (time - since[c]);
-    }
-    double speed(int c, double time) const {
-      return turns() ? cross(spin, turned(time) - pivot)[c] : velocity[c];
     }
     // A turning node's position at `time`: its offset from the pivot when taken, turned by
     // Rodrigues' formula through |spin| (time − since) about spin.
