@@ -86,9 +86,9 @@ case "${1:-}" in
     build_debug
     # 4 and 6 ranks run in the release stage; under -O1 they took 85 of CI's 1500 s, and 2, 3
     # and 2x2 ranks already split the grid both ways, unevenly and across threads.
-    ctest --preset debug -j "$(nproc)" -L '^(unit|mpi)$' -E '^mpi_(4|6)x1$'
+    ctest --preset debug -j "$(nproc)" -L '^(unit_shards|mpi)$' -E '^mpi_(4|6)x1$'
     build_asan
-    ctest --preset asan -j "$(nproc)" -L '^(unit|cli)$'
+    ctest --preset asan -j "$(nproc)" -L '^(unit_shards|cli)$'
     fuzz_scene_loader
     ;;
   *)
