@@ -2,7 +2,8 @@
 # The README's two commands, for a fresh Debian 12 machine (as root, or with sudo):
 #   bash quickstart.sh demo   install what is missing, build, run S6 to the end of its squeeze,
 #                             render a picture of its folds and an animation of the run
-#   bash quickstart.sh test   install what is missing, build, run every test; then the debug
+#   bash quickstart.sh test   install what is missing (and a one-node Slurm, for the job
+#                             scripts' test), build, run every test; then the debug
 #                             build (assertions, bounds and halo checks, FPE traps) runs the
 #                             unit and mpi tests again, the ASan + UBSan build the unit and
 #                             cli tests, and libFuzzer the scene loader for a minute
@@ -17,11 +18,13 @@ PACKAGES=(
   python3 python3-numpy python3-h5py python3-matplotlib ffmpeg
   clang-14 libclang-rt-14-dev
 )
+# Only the test command's: a one-node Slurm for the job scripts' test (jobs/slurm_local.sh).
+TEST_PACKAGES=(slurmd slurmctld slurm-client munge)
 BUILD_DIR=build/release
 
 install_missing() {
   local missing=()
-  for p in "${PACKAGES[@]}"; do
+  for p in "${PACKAGES[@]}" "$@"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   [ ${#missing[@]} -eq 0 ] && return 0
@@ -80,7 +83,7 @@ case "${1:-}" in
       "s6_compression.png (the most deformed frame), s6_compression.mp4 (the run)"
     ;;
   test)
-    install_missing
+    install_missing "${TEST_PACKAGES[@]}"
     build
     ctest --preset release -j "$(nproc)"
     build_debug
