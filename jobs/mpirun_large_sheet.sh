@@ -34,9 +34,20 @@ elif [[ ${OVERWRITE:-0} == 1 ]]; then
 fi
 root=()
 if [[ $(id -u) == 0 ]]; then root=(--allow-run-as-root); fi
-# One rank per THREADS cores, its threads kept on them.
+# CHECKPOINT_EVERY=0: no checkpoints; COSSERAT_ARGS: more arguments of `cosserat run`, split at
+# spaces (a scaling study's: --set time.output_every=STEPS --set output.fields=[]).
+checkpoint=(--checkpoint-every "${CHECKPOINT_EVERY:-$(( steps / 10 > 0 ? steps / 10 : 1 ))}")
+[[ ${CHECKPOINT_EVERY:-} == 0 ]] && checkpoint=()
+read -ra more <<<"${COSSERAT_ARGS:-}"
+# One rank per THREADS cores, its threads kept on them; with more ranks x threads than cores
+# (OVERSUBSCRIBE=1) nothing is bound, since no binding can give each thread a core.
 export OMP_NUM_THREADS=$threads OMP_PROC_BIND=close OMP_PLACES=cores
-mpirun "${root[@]}" -np "$ranks" --map-by "slot:PE=$threads" --bind-to core \
+mapping=(--map-by "slot:PE=$threads" --bind-to core)
+if [[ ${OVERSUBSCRIBE:-0} == 1 ]]; then
+  mapping=(--oversubscribe --bind-to none)
+  export OMP_PROC_BIND=false
+fi
+mpirun "${root[@]}" -np "$ranks" "${mapping[@]}" \
   "$cosserat" run "$stem.toml" -o "$stem.h5" --summary "$stem.json" \
-  --checkpoint-every $(( steps / 10 > 0 ? steps / 10 : 1 )) "${restart[@]}"
+  "${checkpoint[@]}" "${restart[@]}" "${more[@]}"
 /usr/bin/python3 "$here/log_scaling.py" "$stem.json" "$outdir/scaling.csv" mpirun 1
