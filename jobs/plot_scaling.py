@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Strong and weak scaling efficiency from scaling logs (jobs/log_scaling.py).
 
-    jobs/plot_scaling.py [--strong LOG.csv] [--weak LOG.csv] [--cores N] --output STEM
+    jobs/plot_scaling.py [--strong LOG.csv] [--weak LOG.csv] [--cores N] [--title T] --output STEM
 
 Writes STEM.md (a table a study) and STEM.png (efficiency against ranks x threads).
 With p = ranks x threads and r(p) the node-steps a second of a run:
@@ -56,6 +56,7 @@ def main():
     parser.add_argument("--weak")
     parser.add_argument("--cores", type=int, default=os.cpu_count())
     parser.add_argument("--output", required=True)
+    parser.add_argument("--title", default="Scaling efficiency, S1-like sheet (jobs/scaling_study.sh)")
     args = parser.parse_args()
     studies = [(k, p) for k, p in (("strong", args.strong), ("weak", args.weak)) if p]
     if not studies:
@@ -96,7 +97,7 @@ def main():
     ax.set_ylim(0, 1.2)
     ax.set_xscale("log", base=2)
     ax.legend(fontsize=8)
-    ax.set_title("Scaling efficiency, S1-like sheet (jobs/scaling_study.sh)", fontsize=10)
+    ax.set_title(args.title, fontsize=10)
     fig.tight_layout()
     fig.savefig(args.output + ".png", dpi=120)
     with open(args.output + ".md", "w") as f:

@@ -59,6 +59,14 @@ struct Block {
   bool owns(int k, int l) const { return k >= k0 && k < k1 && l >= l0 && l < l1; }
 };
 
+#if defined(COSSERAT_SMPI)
+// The simulated clusters' build (benchmarks/smpi, docs/parallel.md "Simulated clusters"): set,
+// every field of every simulated rank lies in SMPI's one folded block (UntouchedAllocator), so
+// a thousand ranks' fields fit this machine. Their values are then meaningless, which a study
+// that only times the steps allows.
+inline bool smpi_fold_fields = false;
+#endif
+
 // Leaves an element built without arguments untouched, so that a vector's pages are first
 // written, and so placed in memory near the core, by whoever fills it (Field below). Only for
 // implicit-lifetime types, whose bytes need no constructor to be a value.
@@ -78,6 +86,16 @@ struct UntouchedAllocator : std::allocator<T> {
   void construct(U* p, Args&&... args) {
     ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
+#if defined(COSSERAT_SMPI)
+  T* allocate(std::size_t count) {
+    if (!smpi_fold_fields) return std::allocator<T>::allocate(count);
+    return static_cast<T*>(SMPI_SHARED_MALLOC(count * sizeof(T)));
+  }
+  void deallocate(T* p, std::size_t count) {
+    if (!smpi_fold_fields) return std::allocator<T>::deallocate(p, count);
+    SMPI_SHARED_FREE(p);
+  }
+#endif
 };
 
 // One value per node of a block, ghosts included, in one contiguous array. Its rows are zeroed
