@@ -71,8 +71,8 @@ int main(int argc, char** argv) {
     const double compute_flops = compute_seconds * sg_host_get_speed(sg_host_self());
     auto step = [&] {
       if (compute_flops > 0.0) smpi_execute_flops(compute_flops);
-      // With folded fields a step's values mean nothing, and its check cannot fail: the
-      // proposed positions lie where the current ones do.
+      // With folded fields a step's values mean nothing, and the check passes it
+      // (Stepper::check, COSSERAT_SMPI).
       if (simulation.step()) status = 3;
     };
     // The first steps fill caches and lists: timed after them.
@@ -96,8 +96,10 @@ int main(int argc, char** argv) {
                   seconds > 0.0 ? slowest_halo / seconds : 0.0, status == 0 ? "ok" : "unstable");
     }
   } catch (const std::exception& e) {
+    // A bad scene fails every rank alike, but an error of one rank must not leave the others
+    // waiting.
     std::fprintf(stderr, "smpi_step: %s\n", e.what());
-    status = 2;
+    MPI_Abort(MPI_COMM_WORLD, 2);
   }
   MPI_Finalize();
   return status;
