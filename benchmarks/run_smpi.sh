@@ -66,7 +66,7 @@ cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
 run_study() {  # name kind grid|per-rank ranks...
   local name=$1 kind=$2 size=$3 log=$stem-$1.csv
   shift 3
-  echo "date,revision,machine,cpu,launcher,machines,ranks,threads,split,grid,steps,wall_seconds,node_steps_per_second,halo_seconds,status,summary" >"$log"
+  rm -f "$log"
   for p in "$@"; do
     local grid=$size
     [[ $kind == weak ]] && grid=$(/usr/bin/python3 -c "print(round($size * $p ** 0.5))")
@@ -92,19 +92,28 @@ PY
     line=$("${smpi[@]}" -np "$p" --cfg=smpi/simulate-computation:no build/smpi/smpi_step \
       "$work/sheet.toml" "$steps" --warmup 1 --fold --compute-ns "$ns" \
       --set "grid.nodes=[$grid,$grid]" | tail -1)
-    /usr/bin/python3 - "$line" "$revision" "$cpu" "$ns" "$(date -u +%Y-%m-%dT%H:%M:%SZ)" >>"$log" <<'PY'
-import sys
-f = sys.argv[1].split(",")
-ranks, grid, block, steps, per_step, rate, halo_share, status = f
-revision, cpu, ns, date = sys.argv[2:]
+    /usr/bin/python3 - "$line" "$revision" "$cpu" "$ns" "$log" <<'PY'
+# A line of the scaling log jobs/log_scaling.py writes, from smpi_step's CSV line.
+import csv, datetime, os, sys
+sys.path.insert(0, "jobs")
+from log_scaling import FIELDS
+ranks, grid, block, steps, per_step, rate, halo_share, status = sys.argv[1].split(",")
+revision, cpu, ns, log = sys.argv[2:]
 seconds = float(per_step) * int(steps)
 bx, by = (int(v) for v in block.split("x"))
 gx, gy = (int(v) for v in grid.split("x"))
-split = f"{round(gx / bx)}x{round(gy / by)}"
-machine = "simulated: benchmarks/smpi/fat_tree_1024.xml"
-calibration = f"calibrated {float(ns):.3g} ns a node-step on {cpu}"
-print(f"{date},{revision},{machine},{calibration},smpi,{ranks},{ranks},1,{split},{grid},{steps},"
-      f"{seconds:.9g},{rate},{float(halo_share) * seconds:.9g},{status},")
+row = dict(date=datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+           revision=revision, machine="simulated: benchmarks/smpi/fat_tree_1024.xml",
+           cpu=f"calibrated {float(ns):.3g} ns a node-step on {cpu}", launcher="smpi",
+           machines=ranks, ranks=ranks, threads=1, split=f"{round(gx / bx)}x{round(gy / by)}",
+           grid=grid, steps=steps, wall_seconds=f"{seconds:.9g}", node_steps_per_second=rate,
+           halo_seconds=f"{float(halo_share) * seconds:.9g}", status=status, summary="")
+new = not os.path.exists(log)
+with open(log, "a", newline="") as f:
+    writer = csv.DictWriter(f, fieldnames=FIELDS)
+    if new:
+        writer.writeheader()
+    writer.writerow(row)
 PY
     echo "$name: $(tail -1 "$log" | cut -d, -f6,9,10,13)"
   done
