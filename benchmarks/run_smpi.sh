@@ -8,6 +8,8 @@
 #   RANKS        rank counts of weak-256 and strong-4096   (default "1 4 16 64 256 1024")
 #   LARGE_RANKS  rank counts of weak-1024 and strong-16384 (default "1 4 16 64")
 #   STEPS        timed steps a run, after one more          (default 2)
+#   CALIBRATION  a calibration CSV of an earlier run to use instead of calibrating again
+#   APPEND       1: add the runs to the studies' logs of the day instead of starting them afresh
 # The simulation runs every rank's steps on this machine, one after another, on folded memory:
 # about 0.9 us a node to build a run and 0.2 us a node-step, so 1024² a rank on 1024 ranks
 # takes about half an hour, and each rank count of strong-16384 about seven minutes.
@@ -44,21 +46,33 @@ export OMP_NUM_THREADS=1
 # took 33-52 s of SimGrid's time, with these 0.9 s.
 smpi=(smpirun --cfg=smpi/coll-selector:ompi --log=root.thres:warning -platform "$platform")
 
-echo "block,nodes,steps,seconds_per_step,ns_per_node_step" >"$stem-calibration.csv"
-for b in 128 256 512 1024 2048 4096; do
-  jobs/make_large_sheet.sh "$b" 100 "$work/calibrate.toml"
-  n=$((30000000 / (b * b)))
-  n=$((n < 3 ? 3 : n > 2000 ? 2000 : n))
-  line=$("${smpi[@]}" -np 1 --cfg=smpi/host-speed:1Gf build/smpi/smpi_step \
-    "$work/calibrate.toml" "$n" --warmup 2 | tail -1)
-  /usr/bin/python3 - "$b" "$n" "$line" >>"$stem-calibration.csv" <<'PY'
+calibrate() {  # the one-core step of each block size, into $1
+  echo "block,nodes,steps,seconds_per_step,ns_per_node_step" >"$1"
+  for b in 128 256 512 1024 2048 4096; do
+    jobs/make_large_sheet.sh "$b" 100 "$work/calibrate.toml"
+    n=$((30000000 / (b * b)))
+    n=$((n < 3 ? 3 : n > 2000 ? 2000 : n))
+    line=$("${smpi[@]}" -np 1 --cfg=smpi/host-speed:1Gf build/smpi/smpi_step \
+      "$work/calibrate.toml" "$n" --warmup 2 | tail -1)
+    /usr/bin/python3 - "$b" "$n" "$line" >>"$1" <<'PY'
 import sys
 b, n, line = int(sys.argv[1]), int(sys.argv[2]), sys.argv[3].split(",")
 seconds = float(line[4])
 print(f"{b},{b * b},{n},{seconds:.9g},{seconds / (b * b) * 1e9:.6g}")
 PY
-  echo "calibrated: $(tail -1 "$stem-calibration.csv")"
-done
+    echo "calibrated: $(tail -1 "$1")"
+  done
+}
+if [[ -n ${CALIBRATION:-} ]]; then
+  [[ -f $CALIBRATION ]] || {
+    echo "error: no calibration file $CALIBRATION" >&2
+    exit 2
+  }
+  calibration=$CALIBRATION
+else
+  calibration=$stem-calibration.csv
+  calibrate "$calibration"
+fi
 
 jobs/make_large_sheet.sh 256 100 "$work/sheet.toml"
 revision=$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
@@ -66,12 +80,12 @@ cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
 run_study() {  # name kind grid|per-rank ranks...
   local name=$1 kind=$2 size=$3 log=$stem-$1.csv
   shift 3
-  rm -f "$log"
+  [[ ${APPEND:-0} == 1 ]] || rm -f "$log"
   for p in "$@"; do
     local grid=$size
     [[ $kind == weak ]] && grid=$(/usr/bin/python3 -c "print(round($size * $p ** 0.5))")
     local ns
-    ns=$(/usr/bin/python3 - "$stem-calibration.csv" "$grid" "$p" <<'PY'
+    ns=$(/usr/bin/python3 - "$calibration" "$grid" "$p" <<'PY'
 import csv, math, sys
 rows = [(int(r["block"]), float(r["ns_per_node_step"])) for r in csv.DictReader(open(sys.argv[1]))]
 grid, ranks = int(sys.argv[2]), int(sys.argv[3])
