@@ -23,8 +23,22 @@ constexpr double kOnFloor = 1e-6;
 // cells of its own four in a flat sheet, and the lists serve until a node moves half of it.
 constexpr double kMargin = 0.25;
 
-// Numbers per node in the gather: start, end, velocity and the held mark.
-constexpr int kPerNode = 10;
+// Numbers per node sent to another rank: its number k + m l, start, end, velocity and the held
+// mark.
+constexpr int kPerNode = 11;
+
+// Numbers per rank in the exchange of what its nodes reach (SelfContact::gather): the box of its
+// nodes over the step (low and high corners), the largest extent at the step's start of the
+// cells whose first corner it owns, the farthest one of its nodes moves in a coordinate, and
+// whether all its positions are finite.
+constexpr int kReach = 9;
+
+// How many pairs apart the response can carry a node's state to another's: each pass of the
+// positions and of the velocities moves a node by its pairs' means, one pair further each pass,
+// friction adds one, the statistics read a pair's other nodes after them, and a border edge's
+// pair reads the cells beside both edges. A node this many pairs from every node a rank owns
+// cannot change what the rank's nodes end the step with.
+constexpr int kHops = 2 * kPasses + 3;
 
 // A cell's box, in spacings of the hash, may cover up to this many buckets; larger cells (a
 // sheet tearing apart) are tested against every node.
@@ -98,23 +112,19 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
       const Vec3 normal = rotate(solid.pose.orientation, {0.0, 0.0, 1.0});
       floors_.push_back({normal, dot(normal, solid.pose.position) + solid.thickness});
     }
-  const int mine[4] = {block.k0, block.k1, block.l0, block.l1};
-  extents_.resize(4 * static_cast<std::size_t>(ranks_));
-  MPI_Allgather(mine, 4, MPI_INT, extents_.data(), 4, MPI_INT, block.comm);
-  counts_.resize(static_cast<std::size_t>(ranks_));
-  offsets_.resize(static_cast<std::size_t>(ranks_));
-  int offset = 0;
-  for (int r = 0; r < ranks_; ++r) {
-    const int* e = &extents_[4 * static_cast<std::size_t>(r)];
-    counts_[static_cast<std::size_t>(r)] = kPerNode * (e[1] - e[0]) * (e[3] - e[2]);
-    offsets_[static_cast<std::size_t>(r)] = offset;
-    offset += counts_[static_cast<std::size_t>(r)];
-  }
   const auto nodes = static_cast<std::size_t>(block.m) * static_cast<std::size_t>(block.n);
   if (ranks_ > 1) {
-    receive_.resize(static_cast<std::size_t>(offset));
-    send_.resize(static_cast<std::size_t>(kPerNode) * static_cast<std::size_t>(block.owned_k()) *
-                 static_cast<std::size_t>(block.owned_l()));
+    reach_.resize(kReach * static_cast<std::size_t>(ranks_));
+    send_counts_.resize(static_cast<std::size_t>(ranks_));
+    send_offsets_.resize(static_cast<std::size_t>(ranks_));
+    receive_counts_.resize(static_cast<std::size_t>(ranks_));
+    receive_offsets_.resize(static_cast<std::size_t>(ranks_));
+  }
+  present_.assign(nodes, ranks_ == 1 ? 1 : 0);
+  if (ranks_ == 1) {
+    present_nodes_.resize(nodes);
+    for (std::size_t i = 0; i < nodes; ++i) present_nodes_[i] = static_cast<std::int32_t>(i);
+    present_cells();
   }
   start_.resize(nodes);
   end_.resize(nodes);
@@ -154,9 +164,18 @@ bool SelfContact::on_floor(const Vec3& x) const {
   return false;
 }
 
-// Every rank takes the whole grid's state of the step: the response below is then the same
-// serial computation on every rank. Its cost grows with the whole grid, not the block
-// (docs/contact.md, "Self-contact", "Cost"). Whether every position is finite.
+// The nodes whose state of the step this rank needs (docs/contact.md, "Self-contact", "Parallel
+// runs and restarts"): its own and every node of another rank within kHops pairs of them, so
+// that the response below, the same computation on every rank over the nodes it holds, gives
+// its own nodes the bits one rank would. The two nodes of a pair lie within 2t + margin + 2D
+// of each other in every coordinate, their boxes over the step taken, D the largest side of a
+// cell's box over the step: a node is within t of a triangle's cell box, which holds the
+// corners' boxes; two edges' nearest points are within t at the step's end, or met within t
+// of both edges during it, and each node lies within an edge's extent of them. D is at most
+// the largest extent of a cell's corners at the step's start plus twice the farthest any node
+// moves in a coordinate. So each rank sends another the nodes whose box lies within
+// kHops (2t + margin + 2D) of the other's box of nodes. Whether every position is finite, on
+// every rank.
 bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                          const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
                          const std::vector<char>& held) {
@@ -175,8 +194,8 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
         drift_ = std::max({drift_, std::abs(r[a] - built_[i][a]), std::abs(r1[a] - built_[i][a])});
   };
   const auto m = static_cast<std::size_t>(b.m);
-  // One rank: no message, no buffer between the fields and the arrays, and the velocities and
-  // masses only of the nodes the pairs reach (respond).
+  // One rank: no message, and the velocities and masses only of the nodes the pairs reach
+  // (respond).
   if (ranks_ == 1) {
     for (int l = b.l0; l < b.l1; ++l)
       for (int k = b.k0; k < b.k1; ++k)
@@ -184,31 +203,117 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
              next(k, l));
     return finite;
   }
-  std::size_t at = 0, owned = 0;
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  double mine[kReach] = {kInfinity,  kInfinity, kInfinity, -kInfinity, -kInfinity,
+                         -kInfinity, 0.0,       0.0,       1.0};
+  for (int l = b.l0; l < b.l1; ++l)
+    for (int k = b.k0; k < b.k1; ++k) {
+      const Vec3 &r = current(k, l), &r1 = next(k, l);
+      if (!is_finite(r) || !is_finite(r1)) mine[8] = 0.0;
+      for (int a = 0; a < 3; ++a) {
+        mine[a] = std::min({mine[a], r[a], r1[a]});
+        mine[3 + a] = std::max({mine[3 + a], r[a], r1[a]});
+        mine[7] = std::max(mine[7], std::abs(r1[a] - r[a]));
+      }
+      // The start positions of the ring around the block are its neighbours' (exchanged).
+      if (k + 1 < b.m && l + 1 < b.n)
+        for (int a = 0; a < 3; ++a) {
+          const double x[4] = {r[a], current(k + 1, l)[a], current(k, l + 1)[a],
+                               current(k + 1, l + 1)[a]};
+          mine[6] = std::max(mine[6], *std::max_element(x, x + 4) - *std::min_element(x, x + 4));
+        }
+    }
+  MPI_Allgather(mine, kReach, MPI_DOUBLE, reach_.data(), kReach, MPI_DOUBLE, b.comm);
+  double extent = 0.0, farthest = 0.0;
+  for (int rank = 0; rank < ranks_; ++rank) {
+    const double* other = &reach_[kReach * static_cast<std::size_t>(rank)];
+    if (!(other[8] != 0.0)) return false;
+    extent = std::max(extent, other[6]);
+    farthest = std::max(farthest, other[7]);
+  }
+  const double reach = kHops * (2.0 * thickness_ + margin_ + 2.0 * (extent + 2.0 * farthest));
+
+  const int me = rank_in(b.comm);
+  send_.clear();
+  for (int rank = 0; rank < ranks_; ++rank) {
+    const auto r = static_cast<std::size_t>(rank);
+    send_offsets_[r] = static_cast<int>(send_.size());
+    const double* other = &reach_[kReach * r];
+    bool near = rank != me;
+    for (int a = 0; a < 3; ++a)
+      near = near && mine[a] <= other[3 + a] + reach && mine[3 + a] >= other[a] - reach;
+    if (near) {
+      std::size_t owned = 0;
+      for (int l = b.l0; l < b.l1; ++l)
+        for (int k = b.k0; k < b.k1; ++k, ++owned) {
+          const Vec3 &x = current(k, l), &x1 = next(k, l);
+          bool reaches = true;
+          for (int a = 0; a < 3; ++a)
+            reaches = reaches && std::min(x[a], x1[a]) <= other[3 + a] + reach &&
+                      std::max(x[a], x1[a]) >= other[a] - reach;
+          if (!reaches) continue;
+          send_.push_back(static_cast<double>(k) + static_cast<double>(m) * l);
+          for (const Vec3& v :
+               {x, x1, velocity_of(k, l, dt, current, next, next_velocities, starts)}) {
+            send_.push_back(v.x);
+            send_.push_back(v.y);
+            send_.push_back(v.z);
+          }
+          send_.push_back(held[owned] != 0 ? 1.0 : 0.0);
+        }
+    }
+    send_counts_[r] = static_cast<int>(send_.size()) - send_offsets_[r];
+  }
+  MPI_Alltoall(send_counts_.data(), 1, MPI_INT, receive_counts_.data(), 1, MPI_INT, b.comm);
+  int received = 0;
+  for (int rank = 0; rank < ranks_; ++rank) {
+    receive_offsets_[static_cast<std::size_t>(rank)] = received;
+    received += receive_counts_[static_cast<std::size_t>(rank)];
+  }
+  receive_.resize(static_cast<std::size_t>(received));
+  MPI_Alltoallv(send_.data(), send_counts_.data(), send_offsets_.data(), MPI_DOUBLE,
+                receive_.data(), receive_counts_.data(), receive_offsets_.data(), MPI_DOUBLE,
+                b.comm);
+
+  for (const std::int32_t i : present_nodes_) present_[static_cast<std::size_t>(i)] = 0;
+  last_present_.swap(present_nodes_);
+  present_nodes_.clear();
+  std::size_t owned = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k, ++owned) {
-      for (const Vec3& x : {current(k, l), next(k, l),
-                            velocity_of(k, l, dt, current, next, next_velocities, starts)}) {
-        send_[at++] = x.x;
-        send_[at++] = x.y;
-        send_[at++] = x.z;
-      }
-      send_[at++] = held[owned] != 0 ? 1.0 : 0.0;
+      const std::size_t i = static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l);
+      take(i, current(k, l), next(k, l));
+      motion(i, velocity_of(k, l, dt, current, next, next_velocities, starts), held[owned] != 0);
+      present_nodes_.push_back(static_cast<std::int32_t>(i));
     }
-  MPI_Allgatherv(send_.data(), static_cast<int>(send_.size()), MPI_DOUBLE, receive_.data(),
-                 counts_.data(), offsets_.data(), MPI_DOUBLE, b.comm);
-  for (int rank = 0; rank < ranks_; ++rank) {
-    const int* e = &extents_[4 * static_cast<std::size_t>(rank)];
-    std::size_t from = static_cast<std::size_t>(offsets_[static_cast<std::size_t>(rank)]);
-    for (int l = e[2]; l < e[3]; ++l)
-      for (int k = e[0]; k < e[1]; ++k, from += kPerNode) {
-        const double* x = &receive_[from];
-        const auto i = static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l);
-        take(i, {x[0], x[1], x[2]}, {x[3], x[4], x[5]});
-        motion(i, {x[6], x[7], x[8]}, x[9] != 0.0);
-      }
+  for (std::size_t at = 0; at < receive_.size(); at += kPerNode) {
+    const double* x = &receive_[at];
+    const auto i = static_cast<std::size_t>(x[0]);
+    take(i, {x[1], x[2], x[3]}, {x[4], x[5], x[6]});
+    motion(i, {x[7], x[8], x[9]}, x[10] != 0.0);
+    present_nodes_.push_back(static_cast<std::int32_t>(i));
+  }
+  std::sort(present_nodes_.begin(), present_nodes_.end());
+  for (const std::int32_t i : present_nodes_) present_[static_cast<std::size_t>(i)] = 1;
+  // Nodes that were not here at the last build have no candidate lists.
+  if (present_nodes_ != last_present_) {
+    drift_ = std::numeric_limits<double>::infinity();
+    present_cells();
   }
   return finite;
+}
+
+// The cells whose four corners this rank holds, in increasing order.
+void SelfContact::present_cells() {
+  const auto m = static_cast<std::size_t>(block_->m), n = static_cast<std::size_t>(block_->n);
+  present_cells_.clear();
+  for (const std::int32_t node : present_nodes_) {
+    const auto i = static_cast<std::size_t>(node);
+    const std::size_t k = i % m, l = i / m;
+    if (k + 1 < m && l + 1 < n && present_[i + 1] != 0 && present_[i + m] != 0 &&
+        present_[i + m + 1] != 0)
+      present_cells_.push_back(static_cast<std::int32_t>(k + (m - 1) * l));
+  }
 }
 
 // A node's velocity and inverse mass for the response: none for a held node or one on a floor.
@@ -279,7 +384,9 @@ void SelfContact::build_candidates(double extent_sum) {
   const std::size_t cells = box_lo_.size();
   const std::size_t nodes = end_.size();
   const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
-  const double spacing = std::max(extent_sum / static_cast<double>(cells), thickness_);
+  const double spacing =
+      std::max(extent_sum / static_cast<double>(std::max<std::size_t>(present_cells_.size(), 1)),
+               thickness_);
   const double inverse = 1.0 / spacing;
   std::size_t buckets = 1;
   while (buckets < 8 * cells) buckets *= 2;
@@ -297,7 +404,8 @@ void SelfContact::build_candidates(double extent_sum) {
   large_cells_.clear();
   std::int64_t first[3], last[3];
   for (int pass = 0; pass < 2; ++pass) {
-    for (std::size_t c = 0; c < cells; ++c) {
+    for (const std::int32_t cell : present_cells_) {
+      const auto c = static_cast<std::size_t>(cell);
       if (range(box_lo_[c], box_hi_[c], first, last) > kMostBuckets) {
         if (pass == 0) large_cells_.push_back(static_cast<std::int32_t>(c));
         continue;
@@ -327,7 +435,7 @@ void SelfContact::build_candidates(double extent_sum) {
   auto each_cell_near = [&](const Vec3& lo, const Vec3& hi, auto&& consider) {
     std::int64_t from[3], to[3];
     if (range(lo, hi, from, to) > kMostBuckets) {
-      for (std::size_t c = 0; c < cells; ++c) consider(c);
+      for (const std::int32_t c : present_cells_) consider(static_cast<std::size_t>(c));
     } else {
       for (std::int64_t i = from[0]; i <= to[0]; ++i)
         for (std::int64_t j = from[1]; j <= to[1]; ++j)
@@ -356,7 +464,8 @@ void SelfContact::build_candidates(double extent_sum) {
     std::vector<std::int32_t>& found = thread_lists_[me];
     std::vector<std::int32_t>& candidates = thread_candidates_[me];
 #pragma omp for schedule(static)
-    for (std::size_t p = 0; p < nodes; ++p) {
+    for (std::size_t at = 0; at < present_nodes_.size(); ++at) {
+      const auto p = static_cast<std::size_t>(present_nodes_[at]);
       Vec3 lo = start_[p], hi = lo;
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::min(lo[a], end_[p][a]) - reach;
@@ -419,9 +528,12 @@ void SelfContact::build_candidates(double extent_sum) {
   };
   std::vector<std::int32_t>& sides = thread_candidates_[0];
   for (const std::int32_t e : border_edges_) {
+    const auto mine = edge_nodes(e);
+    if (present_[static_cast<std::size_t>(mine[0])] == 0 ||
+        present_[static_cast<std::size_t>(mine[1])] == 0)
+      continue;
     Vec3 lo, hi;
     edge_box(e, reach, lo, hi);
-    const auto mine = edge_nodes(e);
     sides.clear();
     auto consider = [&](std::size_t c) {
       for (int a = 0; a < 3; ++a)
@@ -492,9 +604,6 @@ void SelfContact::cell_planes(std::size_t c) {
 // itself is held at the thickness as two layers anywhere else are, from one cell beyond the
 // crease's nodes; within a cell the bending holds the fold (docs/contact.md, "Self-contact").
 void SelfContact::find_pairs() {
-  const Block& b = *block_;
-  const int m = b.m, n = b.n;
-  const int cells_k = m - 1;
   // The candidates of the last build serve while no node has moved more than half the margin
   // from where it was then (in any coordinate): a cell's box over any later step then lies
   // within half the margin of its box at the build, and a node's within half the margin of
@@ -506,17 +615,12 @@ void SelfContact::find_pairs() {
   // in static chunks; the threads' pairs joined in thread order are the pairs in row order, the
   // same for any count.
   if (!(drift_ <= 0.5 * margin_)) {
-    row_extents_.resize(static_cast<std::size_t>(n - 1));
+    cell_extents_.resize(present_cells_.size());
 #pragma omp parallel for schedule(static)
-    for (int cl = 0; cl < n - 1; ++cl) {
-      double extent_row = 0.0;
-      for (int ck = 0; ck < cells_k; ++ck)
-        extent_row +=
-            cell_box(static_cast<std::size_t>(ck) + static_cast<std::size_t>(cells_k) * cl);
-      row_extents_[static_cast<std::size_t>(cl)] = extent_row;
-    }
+    for (std::size_t e = 0; e < present_cells_.size(); ++e)
+      cell_extents_[e] = cell_box(static_cast<std::size_t>(present_cells_[e]));
     double extent_sum = 0.0;
-    for (const double extent : row_extents_) extent_sum += extent;
+    for (const double extent : cell_extents_) extent_sum += extent;
     build_candidates(extent_sum);
   } else {
 #pragma omp parallel for schedule(static)
@@ -534,77 +638,75 @@ void SelfContact::find_pairs() {
   {
     std::vector<Pair>& found = thread_pairs_[static_cast<std::size_t>(omp_get_thread_num())];
 #pragma omp for schedule(static)
-    for (int l = 0; l < n; ++l)
-      for (int k = 0; k < m; ++k) {
-        const auto p = static_cast<std::size_t>(k) + static_cast<std::size_t>(m) * l;
-        if (list_start_[p] == list_start_[p + 1]) continue;
-        Vec3 lo = start_[p], hi = lo;
-        for (int a = 0; a < 3; ++a) {
-          lo[a] = std::min(lo[a], end_[p][a]) - t;
-          hi[a] = std::max(hi[a], end_[p][a]) + t;
-        }
-        for (std::uint32_t e = list_start_[p]; e < list_start_[p + 1]; ++e) {
-          const std::int32_t c = list_cells_[e];
-          bool apart = false;
-          for (int a = 0; a < 3; ++a)
-            apart = apart || box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a];
-          if (apart) continue;
-          const Triangles triangles = cell_triangles(c);
-          for (int j = 0; j < 4; ++j) {
-            const auto& tri = triangles[j];
-            const Plane& plane =
-                planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
-            // A triangle that turned over in the step (a cell collapsing through itself) has no
-            // side to keep: every node near it would seem to have crossed it, by as much as the
-            // triangle's size, and be thrown that far.
-            if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0) ||
-                !(dot(plane.normal0, plane.normal1) > 0.0))
-              continue;
-            const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
-            const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
-            const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
-            const double side = d0 >= 0.0 ? 1.0 : -1.0;
-            const Vec3& normal = plane.normal1;
-            const double area1 = plane.area1;
-            const double d1 = dot(normal, end_[p] - a1);
-            if (side * d1 >= t) continue;
-            // Crossed over the step: where the node met the plane (linearly between the two
-            // distances) must lie in the triangle, or within the thickness of its edges, or it
-            // passed beside it; it goes back to its side along the triangle's normal. Still on
-            // its side: a foot in the triangle holds it along the normal; a foot beside it (a
-            // node at the cloth's border, which has no triangle beyond the edge) is held the
-            // thickness from the triangle's nearest point, along the line from that point:
-            // beyond the triangle the plane's distance is not the triangle's.
-            const double slack = t / std::sqrt(area1);
-            const Foot at_end = foot(end_[p], a1, b1, c1);
-            Foot on = at_end;
-            double pair_side = side;
-            Vec3 direction = normal;
-            if (side * d1 < 0.0) {
-              const double s = d0 / (d0 - d1);
-              const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
-                                         lerp(b0, b1, s), lerp(c0, c1, s));
-              if (!crossing.near(slack) || !at_end.near(1.0)) continue;
-              on = at_end.clamped();
-            } else if (!at_end.near(0.0)) {
-              if (!at_end.near(slack)) continue;
-              on = at_end.clamped();
-              const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
-              const double distance = norm(away);
-              if (distance >= t) continue;
-              if (distance > 0.0) {
-                direction = away / distance;
-                pair_side = 1.0;
-              }
+    for (std::size_t at = 0; at < present_nodes_.size(); ++at) {
+      const auto p = static_cast<std::size_t>(present_nodes_[at]);
+      if (list_start_[p] == list_start_[p + 1]) continue;
+      Vec3 lo = start_[p], hi = lo;
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], end_[p][a]) - t;
+        hi[a] = std::max(hi[a], end_[p][a]) + t;
+      }
+      for (std::uint32_t e = list_start_[p]; e < list_start_[p + 1]; ++e) {
+        const std::int32_t c = list_cells_[e];
+        bool apart = false;
+        for (int a = 0; a < 3; ++a) apart = apart || box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a];
+        if (apart) continue;
+        const Triangles triangles = cell_triangles(c);
+        for (int j = 0; j < 4; ++j) {
+          const auto& tri = triangles[j];
+          const Plane& plane =
+              planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
+          // A triangle that turned over in the step (a cell collapsing through itself) has no
+          // side to keep: every node near it would seem to have crossed it, by as much as the
+          // triangle's size, and be thrown that far.
+          if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0) ||
+              !(dot(plane.normal0, plane.normal1) > 0.0))
+            continue;
+          const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
+          const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
+          const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
+          const double side = d0 >= 0.0 ? 1.0 : -1.0;
+          const Vec3& normal = plane.normal1;
+          const double area1 = plane.area1;
+          const double d1 = dot(normal, end_[p] - a1);
+          if (side * d1 >= t) continue;
+          // Crossed over the step: where the node met the plane (linearly between the two
+          // distances) must lie in the triangle, or within the thickness of its edges, or it
+          // passed beside it; it goes back to its side along the triangle's normal. Still on
+          // its side: a foot in the triangle holds it along the normal; a foot beside it (a
+          // node at the cloth's border, which has no triangle beyond the edge) is held the
+          // thickness from the triangle's nearest point, along the line from that point:
+          // beyond the triangle the plane's distance is not the triangle's.
+          const double slack = t / std::sqrt(area1);
+          const Foot at_end = foot(end_[p], a1, b1, c1);
+          Foot on = at_end;
+          double pair_side = side;
+          Vec3 direction = normal;
+          if (side * d1 < 0.0) {
+            const double s = d0 / (d0 - d1);
+            const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
+                                       lerp(b0, b1, s), lerp(c0, c1, s));
+            if (!crossing.near(slack) || !at_end.near(1.0)) continue;
+            on = at_end.clamped();
+          } else if (!at_end.near(0.0)) {
+            if (!at_end.near(slack)) continue;
+            on = at_end.clamped();
+            const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
+            const double distance = norm(away);
+            if (distance >= t) continue;
+            if (distance > 0.0) {
+              direction = away / distance;
+              pair_side = 1.0;
             }
-            found.push_back(Pair{{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2]},
-                                 {1.0, -on.a, -on.b, -on.c},
-                                 pair_side,
-                                 0.5,
-                                 direction});
           }
+          found.push_back(Pair{{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2]},
+                               {1.0, -on.a, -on.b, -on.c},
+                               pair_side,
+                               0.5,
+                               direction});
         }
       }
+    }
   }
   pairs_.clear();
   for (const std::vector<Pair>& found : thread_pairs_)
@@ -784,17 +886,23 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
                                       const std::vector<char>& held, NodeVelocities& corrected,
                                       std::vector<char>* moved_rows) {
   const Block& b = *block_;
+  const auto m = static_cast<std::size_t>(b.m);
   SelfContactStats stats;
   // A step that left the grid's numbers (a blow-up) is the stability check's to stop.
   if (!gather(current, next, next_velocities, starts, dt, held)) return stats;
   find_pairs();
-  stats.contacts = static_cast<long>(pairs_.size());
+  // Each pair is counted by the rank that owns its first node: other ranks may hold it too.
+  auto mine = [&](const Pair& q) {
+    const auto i = static_cast<std::size_t>(q.nodes[0]);
+    return ranks_ == 1 || b.owns(static_cast<int>(i % m), static_cast<int>(i / m));
+  };
+  stats.contacts = static_cast<long>(std::count_if(pairs_.begin(), pairs_.end(), mine));
   if (ranks_ == 1)
     for (const Pair& q : pairs_)
       for (const std::int32_t node : q.nodes) {
         const auto i = static_cast<std::size_t>(node);
-        const int k = static_cast<int>(i % static_cast<std::size_t>(b.m));
-        const int l = static_cast<int>(i / static_cast<std::size_t>(b.m));
+        const int k = static_cast<int>(i % m);
+        const int l = static_cast<int>(i / m);
         motion(i, velocity_of(k, l, dt, current, next, next_velocities, starts),
                held[static_cast<std::size_t>(l - b.l0) * static_cast<std::size_t>(b.owned_k()) +
                     static_cast<std::size_t>(k - b.k0)] != 0);
@@ -802,25 +910,29 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
   // A pair between held nodes only moves nothing.
   for (Pair& q : pairs_) q.stiffness = inverse_mass(q);
   std::erase_if(pairs_, [](const Pair& q) { return !(q.stiffness > 0.0); });
-  if (pairs_.empty()) return stats;
-  separate();
-  stop_approach_and_slide(dt);
-  for (const Pair& q : pairs_)
-    stats.closest = std::min(stats.closest, q.side * dot(q.normal, across(q, end_)));
-  const auto m = static_cast<std::size_t>(b.m);
-  for (const std::int32_t node : moved_) {
-    const auto i = static_cast<std::size_t>(node);
-    touched_[i] = 0;
-    const int k = static_cast<int>(i % m), l = static_cast<int>(i / m);
-    if (!b.owns(k, l)) continue;
-    next(k, l) = end_[i];
-    if (next_velocities != nullptr)
-      (*next_velocities)(k, l) = velocity_[i];
-    else
-      corrected.push_back({k, l, velocity_[i]});
-    if (moved_rows != nullptr) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
+  if (!pairs_.empty()) {
+    separate();
+    stop_approach_and_slide(dt);
+    for (const Pair& q : pairs_)
+      if (mine(q)) stats.closest = std::min(stats.closest, q.side * dot(q.normal, across(q, end_)));
+    for (const std::int32_t node : moved_) {
+      const auto i = static_cast<std::size_t>(node);
+      touched_[i] = 0;
+      const int k = static_cast<int>(i % m), l = static_cast<int>(i / m);
+      if (!b.owns(k, l)) continue;
+      next(k, l) = end_[i];
+      if (next_velocities != nullptr)
+        (*next_velocities)(k, l) = velocity_[i];
+      else
+        corrected.push_back({k, l, velocity_[i]});
+      if (moved_rows != nullptr) (*moved_rows)[static_cast<std::size_t>(l - b.l0)] = 1;
+    }
+    moved_.clear();
   }
-  moved_.clear();
+  if (ranks_ > 1) {
+    MPI_Allreduce(MPI_IN_PLACE, &stats.contacts, 1, MPI_LONG, MPI_SUM, b.comm);
+    MPI_Allreduce(MPI_IN_PLACE, &stats.closest, 1, MPI_DOUBLE, MPI_MIN, b.comm);
+  }
   return stats;
 }
 

@@ -436,6 +436,53 @@ TEST(DecompositionInvariance, SelfContactFollowsTheOneBlockRun) {
   }
 }
 
+// A strip 20 m long folded into two 10 m layers: each rank holds only its own nodes and those of
+// other ranks within the response's reach of them (docs/contact.md, "Parallel runs"), about
+// 2.2 m here, and the pairs join blocks that are not neighbours in the grid (a row of the top
+// layer lies over the row of the bottom one n − 1 − l away). Every split follows the one-block
+// run bitwise, and on three or more ranks split along the strip some rank holds fewer nodes
+// than the grid has (checked: with each rank sent every node, the last expectation fails).
+TEST(DecompositionInvariance, SelfContactExchangesOnlyTheNodesWithinReach) {
+  Scene scene = testing::layered_sheet(2e-3);
+  scene.n = 400;
+  scene.size2 = 0.05 * (scene.n - 1);
+  scene.dt = 1e-4;
+  scene.steps = 60;
+  scene.gravity = {0.0, -9.81, 0.0};
+  SolidSpec floor;
+  floor.name = "floor";
+  floor.shape.kind = ShapeKind::plane;
+  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
+  floor.thickness = 1e-3;
+  floor.friction = 0.3;
+  scene.solids.push_back(floor);
+  const Vec3 fired{0.3, -20.0, 0.2};
+  Simulation reference(scene, MPI_COMM_SELF, any_scheme);
+  testing::fold(reference, scene, 1e-3, 0.02, fired);
+  ASSERT_TRUE(testing::advance(reference, scene.steps));
+  ASSERT_GT(reference.self_contact_summary()->max_pairs, 0);
+  const auto nodes = static_cast<std::size_t>(scene.m) * static_cast<std::size_t>(scene.n);
+  EXPECT_EQ(reference.self_contact()->nodes_held(), nodes);
+  bool fewer = false;
+  for (const Decomposition& d : all_splits(scene.m, scene.n, world_size())) {
+    Simulation sim(scene, MPI_COMM_WORLD, d, any_scheme);
+    testing::fold(sim, scene, 1e-3, 0.02, fired);
+    ASSERT_TRUE(testing::advance(sim, scene.steps));
+    EXPECT_EQ(differing_nodes(sim.positions(), reference.positions()), 0)
+        << "split " << split_name(d);
+    EXPECT_EQ(differing_nodes(sim.velocities(), reference.velocities()), 0)
+        << "split " << split_name(d);
+    EXPECT_EQ(sim.self_contact_summary()->max_pairs, reference.self_contact_summary()->max_pairs);
+    EXPECT_EQ(sim.self_contact_summary()->closest, reference.self_contact_summary()->closest);
+    fewer = fewer || sim.self_contact()->nodes_held() < nodes;
+  }
+  int any = fewer ? 1 : 0;
+  MPI_Allreduce(MPI_IN_PLACE, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+  if (world_size() >= 3) {
+    EXPECT_EQ(any, 1) << "every rank held every node";
+  }
+}
+
 // The same with the top layer turned 20° about the vertical through the sheet's middle, so that
 // its border edges cross the bottom layer's edges at an angle and hold them as pairs of edges
 // across the block borders (checked: with the edge pairs left out this run's positions

@@ -45,10 +45,14 @@ class SelfContact {
                            const std::vector<char>& held, NodeVelocities& corrected,
                            std::vector<char>* moved_rows);
 
-  // About what one rank holds for an m x n grid: every rank keeps the whole grid's state of the
-  // step, six positions or velocities and the gather's 10 numbers a node (400 bytes with the
-  // candidate lists), and each cell's box, four planes and eight buckets (370 bytes); the pairs
-  // come on top, a few per node in contact.
+  // How many nodes' state of the last step this rank held: its own and those of other ranks
+  // within reach of them (all of them on one rank).
+  std::size_t nodes_held() const { return present_nodes_.size(); }
+
+  // About what one rank holds for an m x n grid: arrays over the whole grid for the state of
+  // the step of the nodes it holds, six positions or velocities a node and, at most, 11 numbers
+  // received for each (400 bytes with the candidate lists), and each cell's box, four planes and
+  // eight buckets (370 bytes); the pairs come on top, a few per node in contact.
   static double memory_bytes(int m, int n) { return 800.0 * m * n; }
 
  private:
@@ -75,6 +79,7 @@ class SelfContact {
   bool gather(const Field<Vec3>& current, const Field<Vec3>& next,
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
               const std::vector<char>& held);
+  void present_cells();
   void motion(std::size_t i, const Vec3& velocity, bool held);
   bool on_floor(const Vec3& x) const;
   double cell_box(std::size_t c);
@@ -103,12 +108,21 @@ class SelfContact {
   std::vector<Floor> floors_;
   const Block* block_;
   int ranks_;
-  std::vector<int> extents_;  // k0, k1, l0, l1 of every rank's block
-  std::vector<int> counts_, offsets_;
-  std::vector<double> send_, receive_;  // with several ranks only
+  // With several ranks only: what each rank's nodes reach (gather), and the nodes sent to and
+  // received from each rank.
+  std::vector<double> reach_;
+  std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
+  std::vector<double> send_, receive_;
 
-  // The whole grid, k + m l, on every rank: every rank finds the same pairs and moves every
-  // node the same way, so any decomposition gives the same bits.
+  // The nodes this rank holds the step's state of (all of them on one rank): its own and those
+  // of other ranks that can reach them (gather), in increasing k + m l, marked in present_;
+  // those of the last step; and the cells whose four corners it holds. Every rank finds the
+  // pairs among its nodes and moves them as the whole grid would move its own, so any
+  // decomposition gives the same bits.
+  std::vector<char> present_;
+  std::vector<std::int32_t> present_nodes_, last_present_, present_cells_;
+
+  // Arrays over the whole grid, k + m l; only the nodes held are read.
   std::vector<Vec3> start_, end_, velocity_;
   std::vector<double> inverse_mass_;       // this step's: none for a held node or one on a floor
   std::vector<double> node_inverse_mass_;  // 1 / m of every node
@@ -119,7 +133,7 @@ class SelfContact {
   std::vector<std::int32_t> pending_;  // the nodes with a share in this pass's sums
   std::vector<Pair> pairs_;
   std::vector<std::vector<Pair>> thread_pairs_;  // each thread's, in its rows' order
-  std::vector<double> row_extents_;              // the cell boxes' sizes, summed by rows
+  std::vector<double> cell_extents_;             // the largest side of each held cell's box
 
   // A triangle's plane: its normal times twice its area at the step's start, and its unit
   // normal at the end.

@@ -87,6 +87,8 @@ class Simulation {
   ContactSummary contact_summary() const;
   // Nothing when the scene has no [self_contact].
   std::optional<SelfContactSummary> self_contact_summary() const;
+  // The scene's self-contact, or null when it has none.
+  const SelfContact* self_contact() const { return self_contact_.get(); }
 
   // The stored energy of docs/equations.md §2.5 at the current positions (J); a global sum that
   // costs about one force evaluation, so not part of diagnostics().
