@@ -81,7 +81,13 @@ run_one() {  # index label scene steps extra discretisation
   timeout "$HARD_TIMEOUT" "$COSSERAT" "${args[@]}" >/dev/null 2>"$out.err" || rc=$?
   local wall
   wall=$(echo "$(date +%s.%N) - $t0" | bc)
-  /usr/bin/python3 tools/sheet_quality.py "$out.h5" --json >"$out.q.json" 2>>"$out.err" || true
+  # With self-contact, the pairs closer than half the cloth's thickness too (from the summary).
+  local thickness
+  thickness=$(/usr/bin/python3 -c "import json,sys
+try: print((json.load(open(sys.argv[1])).get('self_contact') or {}).get('thickness') or '')
+except Exception: print('')" "$out.json")
+  /usr/bin/python3 tools/sheet_quality.py "$out.h5" --json ${thickness:+--thickness "$thickness"} \
+    >"$out.q.json" 2>>"$out.err" || true
   /usr/bin/python3 - "$out" "$i" "$label" "$disc" "$rc" "$wall" "$steps" <<'PY'
 import json, os, sys
 out, i, label, disc, rc, wall, steps = sys.argv[1:]
@@ -157,7 +163,8 @@ def g(r, k, fmt):
     return "—" if v is None else format(v, fmt)
 cols = ["case", "discretisation or model", "exit", "finished", "stopped at t (s)", "dt (s)", "steps",
         "wall (s)", "min det a/A", "min signed det a/A", "most inverted cells", "min normal cos",
-        "most pairs < h/2", "min far distance / h", "most crossing triangle pairs (cells)",
+        "most pairs < h/2", "most pairs < t/2", "min far distance / h",
+        "most crossing triangle pairs (cells)",
         "area ratio (summary, end)",
         "area ratio min..max (frames)", "message"]
 table = []
@@ -168,7 +175,7 @@ for r in rows:
                   format(r["wall_s"], ".1f"), g(r, "min_det_ratio", ".3g"),
                   g(r, "min_signed_det_ratio", ".3g"), g(r, "inverted_cells", "d"),
                   g(r, "min_normal_cos", ".3f"), g(r, "close_pairs", "d"),
-                  g(r, "min_far_distance_over_h", ".3f"),
+                  g(r, "pairs_below_half_thickness", "d"), g(r, "min_far_distance_over_h", ".3f"),
                   f"{g(r, 'crossing_pairs', 'd')} ({g(r, 'crossing_cells', 'd')})",
                   g(r, "summary_area_ratio", ".4f"),
                   (f"{q['area_ratio']:.3f}..{q['max_area_ratio']:.3f}" if q else "—"),
@@ -187,6 +194,8 @@ lines = [f"# Hard cases: {title}, {date}" + (" (QUICK: 1/10 of every run)" if qu
          "run stopped by the monitor): tools/sheet_quality.py. \"min far distance / h\": "
          "the smallest distance of two nodes more than 3 indices apart, where one is within h; "
          "\"most pairs < h/2\": the most such pairs closer than h/2 in one frame; "
+         "\"most pairs < t/2\": the same closer than half the cloth's thickness t, with "
+         "self-contact only (t from the run's summary); "
          "\"most crossing triangle pairs\": the most pairs of the sheet's triangles that pass "
          "through each other in one frame (an exact test), with the cells they lie in. Exit 3: the "
          "stability monitor stopped the run (message). Wall time includes writing frames.", "",

@@ -146,7 +146,8 @@ std::string to_json(const RunSummary& s) {
   const std::string max_contacts =
       s.contact ? fmt::format("{}", s.contact->max_contacts) : "null";
   const std::string self_contact =
-      s.self_contact ? fmt::format(R"({{"max_pairs": {}, "closest": {}}})",
+      s.self_contact ? fmt::format(R"({{"thickness": {}, "max_pairs": {}, "closest": {}}})",
+                                   json_number(s.self_contact->thickness),
                                    s.self_contact->max_pairs,
                                    std::isfinite(s.self_contact->closest)
                                        ? json_number(s.self_contact->closest)

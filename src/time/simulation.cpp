@@ -212,7 +212,9 @@ ContactSummary Simulation::contact_summary() const {
 
 std::optional<SelfContactSummary> Simulation::self_contact_summary() const {
   if (!self_contact_action_) return std::nullopt;
-  return self_contact_action_->summary();
+  SelfContactSummary summary = self_contact_action_->summary();
+  summary.thickness = scene_->self_contact->thickness;
+  return summary;
 }
 
 double Simulation::memory_bytes(const Block& block, Integrator integrator, const ModelSpec& model,

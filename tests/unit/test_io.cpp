@@ -778,14 +778,16 @@ TEST(RunSummaryTest, HasExactlyTheDesignKeysInOrder) {
 // no closest pair, written null rather than an infinity JSON cannot hold.
 TEST(RunSummaryTest, SelfContactFiguresAreAnObject) {
   RunSummary summary = example_summary();
-  summary.self_contact = SelfContactSummary{12, 0.0008};
+  summary.self_contact = SelfContactSummary{0.0005, 12, 0.0008};
   std::string json = to_json(summary);
-  EXPECT_NE(json.find(R"("self_contact": {"max_pairs": 12, "closest": 0.0008})"),
-            std::string::npos)
+  EXPECT_NE(
+      json.find(R"("self_contact": {"thickness": 0.0005, "max_pairs": 12, "closest": 0.0008})"),
+      std::string::npos)
       << json;
-  summary.self_contact = SelfContactSummary{};
+  summary.self_contact = SelfContactSummary{0.0005, 0, std::numeric_limits<double>::infinity()};
   json = to_json(summary);
-  EXPECT_NE(json.find(R"("self_contact": {"max_pairs": 0, "closest": null})"), std::string::npos)
+  EXPECT_NE(json.find(R"("self_contact": {"thickness": 0.0005, "max_pairs": 0, "closest": null})"),
+            std::string::npos)
       << json;
 }
 

@@ -30,6 +30,7 @@ struct ContactSummary {
 
 // What self-contact did over the accepted steps so far, the same on every rank.
 struct SelfContactSummary {
+  double thickness = 0.0;  // m, the cloth's, which the pairs are held apart by
   long max_pairs = 0;  // most node-triangle pairs closer than the thickness in one step
   // m: the smallest distance of a held pair after a step (infinite: none met)
   double closest = std::numeric_limits<double>::infinity();
