@@ -40,6 +40,10 @@ constexpr int kReach = 9;
 // cannot change what the rank's nodes end the step with.
 constexpr int kHops = 2 * kPasses + 3;
 
+// A rank is sent the nodes within this many times the reach of its own, and builds its lists
+// again only when a node it does not hold comes within the reach itself.
+constexpr double kSpare = 1.5;
+
 // A cell's box, in spacings of the hash, may cover up to this many buckets; larger cells (a
 // sheet tearing apart) are tested against every node.
 constexpr long kMostBuckets = 27;
@@ -232,6 +236,9 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
     farthest = std::max(farthest, other[7]);
   }
   const double reach = kHops * (2.0 * thickness_ + margin_ + 2.0 * (extent + 2.0 * farthest));
+  // Sent: the nodes within half as far again, so that the nodes a rank holds serve it for many
+  // steps of a moving sheet (below).
+  const double sent = kSpare * reach;
 
   const int me = rank_in(b.comm);
   send_.clear();
@@ -241,7 +248,7 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
     const double* other = &reach_[kReach * r];
     bool near = rank != me;
     for (int a = 0; a < 3; ++a)
-      near = near && mine[a] <= other[3 + a] + reach && mine[3 + a] >= other[a] - reach;
+      near = near && mine[a] <= other[3 + a] + sent && mine[3 + a] >= other[a] - sent;
     if (near) {
       std::size_t owned = 0;
       for (int l = b.l0; l < b.l1; ++l)
@@ -249,8 +256,8 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
           const Vec3 &x = current(k, l), &x1 = next(k, l);
           bool reaches = true;
           for (int a = 0; a < 3; ++a)
-            reaches = reaches && std::min(x[a], x1[a]) <= other[3 + a] + reach &&
-                      std::max(x[a], x1[a]) >= other[a] - reach;
+            reaches = reaches && std::min(x[a], x1[a]) <= other[3 + a] + sent &&
+                      std::max(x[a], x1[a]) >= other[a] - sent;
           if (!reaches) continue;
           send_.push_back(static_cast<double>(k) + static_cast<double>(m) * l);
           for (const Vec3& v :
@@ -275,30 +282,46 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                 receive_.data(), receive_counts_.data(), receive_offsets_.data(), MPI_DOUBLE,
                 b.comm);
 
-  for (const std::int32_t i : present_nodes_) present_[static_cast<std::size_t>(i)] = 0;
-  last_present_.swap(present_nodes_);
-  present_nodes_.clear();
+  // The nodes held stay those of the last build while no node this rank does not hold comes
+  // within the reach: the candidate lists cover them. A held node that no rank sends any more
+  // lies beyond the reach and keeps its last state, which changes no node within it.
+  bool rebuild = present_nodes_.empty();
+  for (std::size_t at = 0; at < receive_.size() && !rebuild; at += kPerNode) {
+    const double* x = &receive_[at];
+    if (present_[static_cast<std::size_t>(x[0])] != 0) continue;
+    bool reaches = true;
+    for (int a = 0; a < 3; ++a)
+      reaches = reaches && std::min(x[1 + a], x[4 + a]) <= mine[3 + a] + reach &&
+                std::max(x[1 + a], x[4 + a]) >= mine[a] - reach;
+    rebuild = reaches;
+  }
+  if (rebuild) {
+    for (const std::int32_t i : present_nodes_) present_[static_cast<std::size_t>(i)] = 0;
+    present_nodes_.clear();
+    for (int l = b.l0; l < b.l1; ++l)
+      for (int k = b.k0; k < b.k1; ++k)
+        present_nodes_.push_back(static_cast<std::int32_t>(k + b.m * l));
+    for (std::size_t at = 0; at < receive_.size(); at += kPerNode)
+      present_nodes_.push_back(static_cast<std::int32_t>(receive_[at]));
+    std::sort(present_nodes_.begin(), present_nodes_.end());
+    for (const std::int32_t i : present_nodes_) present_[static_cast<std::size_t>(i)] = 1;
+    present_cells();
+    // Nodes that were not here at the last build have no candidate lists.
+    drift_ = std::numeric_limits<double>::infinity();
+  }
   std::size_t owned = 0;
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k, ++owned) {
       const std::size_t i = static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l);
       take(i, current(k, l), next(k, l));
       motion(i, velocity_of(k, l, dt, current, next, next_velocities, starts), held[owned] != 0);
-      present_nodes_.push_back(static_cast<std::int32_t>(i));
     }
   for (std::size_t at = 0; at < receive_.size(); at += kPerNode) {
     const double* x = &receive_[at];
     const auto i = static_cast<std::size_t>(x[0]);
+    if (present_[i] == 0) continue;
     take(i, {x[1], x[2], x[3]}, {x[4], x[5], x[6]});
     motion(i, {x[7], x[8], x[9]}, x[10] != 0.0);
-    present_nodes_.push_back(static_cast<std::int32_t>(i));
-  }
-  std::sort(present_nodes_.begin(), present_nodes_.end());
-  for (const std::int32_t i : present_nodes_) present_[static_cast<std::size_t>(i)] = 1;
-  // Nodes that were not here at the last build have no candidate lists.
-  if (present_nodes_ != last_present_) {
-    drift_ = std::numeric_limits<double>::infinity();
-    present_cells();
   }
   return finite;
 }

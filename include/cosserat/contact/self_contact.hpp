@@ -114,13 +114,13 @@ class SelfContact {
   std::vector<int> send_counts_, send_offsets_, receive_counts_, receive_offsets_;
   std::vector<double> send_, receive_;
 
-  // The nodes this rank holds the step's state of (all of them on one rank): its own and those
-  // of other ranks that can reach them (gather), in increasing k + m l, marked in present_;
-  // those of the last step; and the cells whose four corners it holds. Every rank finds the
-  // pairs among its nodes and moves them as the whole grid would move its own, so any
-  // decomposition gives the same bits.
+  // The nodes this rank holds the step's state of (all of them on one rank), in increasing
+  // k + m l and marked in present_: its own and those other ranks sent it when it last built its
+  // candidate lists; and the cells whose four corners it holds. Every rank finds the pairs among
+  // its nodes and moves them as one rank would move its own, so any decomposition gives the
+  // same bits.
   std::vector<char> present_;
-  std::vector<std::int32_t> present_nodes_, last_present_, present_cells_;
+  std::vector<std::int32_t> present_nodes_, present_cells_;
 
   // Arrays over the whole grid, k + m l; only the nodes held are read.
   std::vector<Vec3> start_, end_, velocity_;

@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# Self-contact's cost on several ranks: the hanging 1024² S1-like sheet of
+# jobs/make_large_sheet.sh, where nothing touches, on 1 and 2 ranks of one thread, with
+# self-contact off and on (docs/contact.md, "Self-contact", "Parallel runs and restarts").
+#   benchmarks/run_self_contact_ranks.sh [NAME=BUILD_DIR ...]
+# Each NAME=BUILD_DIR (default: this=build/release) is a release build of the solver; the builds
+# are run in turns, round by round, so that the machine's drift falls on each alike.
+# Settings, from the environment: RANKS (default "1 2"), ROUNDS (default 3), NODES (default 1024).
+# A step's cost is (wall(120) − wall(60)) / 60 of runs with one frame each, the least over the
+# rounds: the first step, which builds the candidate lists, and the start-up cancel.
+# Writes benchmarks/results/self-contact-ranks-<host>-<date>.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+builds=("$@")
+[[ ${#builds[@]} -eq 0 ]] && builds=(this=build/release)
+ranks=${RANKS:-1 2}
+rounds=${ROUNDS:-3}
+nodes=${NODES:-1024}
+for spec in "${builds[@]}"; do
+  [[ -x ${spec#*=}/cosserat ]] || {
+    echo "error: no ${spec#*=}/cosserat (build it with cmake --build --preset release)" >&2
+    exit 2
+  }
+done
+export OMP_NUM_THREADS=1 OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+jobs/make_large_sheet.sh "$nodes" 60 "$work/sheet.toml"
+on=(--set 'self_contact={}' --set material.thickness=0.0005)
+
+wall() {  # build ranks steps [args...]: one run's wall time, s
+  local build=$1 p=$2 steps=$3
+  shift 3
+  mpiexec -n "$p" --oversubscribe "$build/cosserat" run "$work/sheet.toml" -q --threads 1 \
+    -o "$work/run.h5" --overwrite --summary "$work/run.json" --set time.steps="$steps" \
+    --set time.output_every="$steps" "$@" >/dev/null
+  /usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['wall_seconds'])" \
+    "$work/run.json"
+}
+
+declare -A least
+for ((round = 0; round < rounds; ++round)); do
+  for spec in "${builds[@]}"; do
+    for p in $ranks; do
+      for mode in off on; do
+        args=()
+        [[ $mode == on ]] && args=("${on[@]}")
+        for steps in 60 120; do
+          key="${spec%%=*} $p $mode $steps"
+          t=$(wall "${spec#*=}" "$p" "$steps" "${args[@]}")
+          least[$key]=$(/usr/bin/python3 -c "print(min($t, ${least[$key]:-1e300}))")
+        done
+      done
+    done
+  done
+done
+
+date=$(date -u +%Y-%m-%d)
+out=benchmarks/results/self-contact-ranks-$(hostname -s)-$date.md
+{
+  echo "# Self-contact's cost on several ranks, $date"
+  echo
+  echo "Machine: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc --all) cores;"
+  echo "compiler: $(c++ --version | head -1); git $(git rev-parse --short=12 HEAD); one thread a rank."
+  echo "\`benchmarks/run_self_contact_ranks.sh ${builds[*]}\`: the hanging ${nodes}² sheet, where"
+  echo "nothing touches; ms a step after the first, (wall(120) − wall(60)) / 60, the least of"
+  echo "$rounds rounds."
+  echo
+  echo "| build | ranks | off (ms a step) | on (ms a step) | on / off − 1 |"
+  echo "|---|---|---|---|---|"
+  for spec in "${builds[@]}"; do
+    for p in $ranks; do
+      n=${spec%%=*}
+      /usr/bin/python3 -c "
+off = (${least[$n $p off 120]} - ${least[$n $p off 60]}) / 60
+on = (${least[$n $p on 120]} - ${least[$n $p on 60]}) / 60
+print(f'| $n | $p | {1e3 * off:.1f} | {1e3 * on:.1f} | {on / off - 1:+.0%} |')"
+    done
+  done
+} >"$out"
+cat "$out"
