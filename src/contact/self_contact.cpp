@@ -407,12 +407,11 @@ void SelfContact::build_candidates(double extent_sum) {
   const std::size_t cells = box_lo_.size();
   const std::size_t nodes = end_.size();
   const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
-  const double spacing =
-      std::max(extent_sum / static_cast<double>(std::max<std::size_t>(present_cells_.size(), 1)),
-               thickness_);
+  const std::size_t held_cells = std::max<std::size_t>(present_cells_.size(), 1);
+  const double spacing = std::max(extent_sum / static_cast<double>(held_cells), thickness_);
   const double inverse = 1.0 / spacing;
   std::size_t buckets = 1;
-  while (buckets < 8 * cells) buckets *= 2;
+  while (buckets < 8 * held_cells) buckets *= 2;
   const std::uint64_t mask = buckets - 1;
   auto range = [&](const Vec3& lo, const Vec3& hi, std::int64_t* first, std::int64_t* last) {
     long count = 1;
