@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Self-contact's cost on several ranks: the hanging 1024² S1-like sheet of
-# jobs/make_large_sheet.sh, where nothing touches, on 1 and 2 ranks of one thread, with
+# Self-contact's cost on several ranks and threads: the hanging 1024² S1-like sheet of
+# jobs/make_large_sheet.sh, where nothing touches, on 1 and 2 ranks (and threads), with
 # self-contact off and on (docs/contact.md, "Self-contact", "Parallel runs and restarts").
 #   benchmarks/run_self_contact_ranks.sh [NAME=BUILD_DIR ...]
 # Each NAME=BUILD_DIR (default: this=build/release) is a release build of the solver; the builds
 # are run in turns, round by round, so that the machine's drift falls on each alike.
-# Settings, from the environment: RANKS (default "1 2"), ROUNDS (default 3), NODES (default 1024).
+# Settings, from the environment: RANKS (default "1 2"), THREADS (threads a rank, default 1),
+# ROUNDS (default 3), NODES (default 1024).
 # A step's cost is (wall(120) − wall(60)) / 60 of runs with one frame each, the least over the
 # rounds: the first step, which builds the candidate lists, and the start-up cancel.
 # Writes benchmarks/results/self-contact-ranks-<host>-<date>.md.
@@ -14,6 +15,7 @@ cd "$(dirname "$0")/.."
 builds=("$@")
 [[ ${#builds[@]} -eq 0 ]] && builds=(this=build/release)
 ranks=${RANKS:-1 2}
+threads=${THREADS:-1}
 rounds=${ROUNDS:-3}
 nodes=${NODES:-1024}
 for spec in "${builds[@]}"; do
@@ -28,10 +30,11 @@ trap 'rm -rf "$work"' EXIT
 jobs/make_large_sheet.sh "$nodes" 60 "$work/sheet.toml"
 on=(--set 'self_contact={}' --set material.thickness=0.0005)
 
-wall() {  # build ranks steps [args...]: one run's wall time, s
-  local build=$1 p=$2 steps=$3
-  shift 3
-  mpiexec -n "$p" --oversubscribe "$build/cosserat" run "$work/sheet.toml" -q --threads 1 \
+wall() {  # build ranks threads steps [args...]: one run's wall time, s
+  local build=$1 p=$2 t=$3 steps=$4
+  shift 4
+  OMP_PROC_BIND=close mpiexec -n "$p" --oversubscribe --bind-to none "$build/cosserat" run \
+    "$work/sheet.toml" -q --threads "$t" \
     -o "$work/run.h5" --overwrite --summary "$work/run.json" --set time.steps="$steps" \
     --set time.output_every="$steps" "$@" >/dev/null
   /usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['wall_seconds'])" \
@@ -42,13 +45,15 @@ declare -A least
 for ((round = 0; round < rounds; ++round)); do
   for spec in "${builds[@]}"; do
     for p in $ranks; do
-      for mode in off on; do
-        args=()
-        [[ $mode == on ]] && args=("${on[@]}")
-        for steps in 60 120; do
-          key="${spec%%=*} $p $mode $steps"
-          t=$(wall "${spec#*=}" "$p" "$steps" "${args[@]}")
-          least[$key]=$(/usr/bin/python3 -c "print(min($t, ${least[$key]:-1e300}))")
+      for t in $threads; do
+        for mode in off on; do
+          args=()
+          [[ $mode == on ]] && args=("${on[@]}")
+          for steps in 60 120; do
+            key="${spec%%=*} $p $t $mode $steps"
+            w=$(wall "${spec#*=}" "$p" "$t" "$steps" "${args[@]}")
+            least[$key]=$(/usr/bin/python3 -c "print(min($w, ${least[$key]:-1e300}))")
+          done
         done
       done
     done
@@ -61,20 +66,22 @@ out=benchmarks/results/self-contact-ranks-$(hostname -s)-$date.md
   echo "# Self-contact's cost on several ranks, $date"
   echo
   echo "Machine: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc --all) cores;"
-  echo "compiler: $(c++ --version | head -1); git $(git rev-parse --short=12 HEAD); one thread a rank."
+  echo "compiler: $(c++ --version | head -1); git $(git rev-parse --short=12 HEAD); OMP_PROC_BIND=close."
   echo "\`benchmarks/run_self_contact_ranks.sh ${builds[*]}\`: the hanging ${nodes}² sheet, where"
   echo "nothing touches; ms a step after the first, (wall(120) − wall(60)) / 60, the least of"
   echo "$rounds rounds."
   echo
-  echo "| build | ranks | off (ms a step) | on (ms a step) | on / off − 1 |"
-  echo "|---|---|---|---|---|"
+  echo "| build | ranks | threads | off (ms a step) | on (ms a step) | on / off − 1 |"
+  echo "|---|---|---|---|---|---|"
   for spec in "${builds[@]}"; do
     for p in $ranks; do
-      n=${spec%%=*}
-      /usr/bin/python3 -c "
-off = (${least[$n $p off 120]} - ${least[$n $p off 60]}) / 60
-on = (${least[$n $p on 120]} - ${least[$n $p on 60]}) / 60
-print(f'| $n | $p | {1e3 * off:.1f} | {1e3 * on:.1f} | {on / off - 1:+.0%} |')"
+      for t in $threads; do
+        n=${spec%%=*}
+        /usr/bin/python3 -c "
+off = (${least[$n $p $t off 120]} - ${least[$n $p $t off 60]}) / 60
+on = (${least[$n $p $t on 120]} - ${least[$n $p $t on 60]}) / 60
+print(f'| $n | $p | $t | {1e3 * off:.1f} | {1e3 * on:.1f} | {on / off - 1:+.0%} |')"
+      done
     done
   done
 } >"$out"

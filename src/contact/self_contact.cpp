@@ -188,23 +188,28 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
   // How far a node has gone from where the candidate lists were built (find_pairs).
   const bool built = !built_.empty();
   drift_ = built ? 0.0 : std::numeric_limits<double>::infinity();
-  // One node's positions into the whole grid's arrays at i = k + m l.
-  auto take = [&](std::size_t i, const Vec3& r, const Vec3& r1) {
+  // One node's positions into the whole grid's arrays at i = k + m l, into a thread's own
+  // `all_finite` and `drift` (whose reductions, && and max, give the same on any count).
+  auto take = [&](std::size_t i, const Vec3& r, const Vec3& r1, bool& all_finite, double& drift) {
     start_[i] = r;
     end_[i] = r1;
-    finite = finite && is_finite(r) && is_finite(r1);
+    all_finite = all_finite && is_finite(r) && is_finite(r1);
     if (built)
       for (int a = 0; a < 3; ++a)
-        drift_ = std::max({drift_, std::abs(r[a] - built_[i][a]), std::abs(r1[a] - built_[i][a])});
+        drift = std::max({drift, std::abs(r[a] - built_[i][a]), std::abs(r1[a] - built_[i][a])});
   };
   const auto m = static_cast<std::size_t>(b.m);
   // One rank: no message, and the velocities and masses only of the nodes the pairs reach
-  // (respond).
+  // (respond). On threads: a sheet where nothing touches spends most of self-contact's time
+  // here.
   if (ranks_ == 1) {
+    double drift = drift_;
+#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : drift)
     for (int l = b.l0; l < b.l1; ++l)
       for (int k = b.k0; k < b.k1; ++k)
         take(static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l), current(k, l),
-             next(k, l));
+             next(k, l), finite, drift);
+    drift_ = drift;
     return finite;
   }
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
@@ -309,20 +314,23 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
     // Nodes that were not here at the last build have no candidate lists.
     drift_ = std::numeric_limits<double>::infinity();
   }
-  std::size_t owned = 0;
+  double drift = drift_;
+#pragma omp parallel for schedule(static) reduction(&& : finite) reduction(max : drift)
   for (int l = b.l0; l < b.l1; ++l)
-    for (int k = b.k0; k < b.k1; ++k, ++owned) {
+    for (int k = b.k0; k < b.k1; ++k) {
       const std::size_t i = static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l);
-      take(i, current(k, l), next(k, l));
+      const std::size_t owned = static_cast<std::size_t>(l - b.l0) * b.owned_k() + (k - b.k0);
+      take(i, current(k, l), next(k, l), finite, drift);
       motion(i, velocity_of(k, l, dt, current, next, next_velocities, starts), held[owned] != 0);
     }
   for (std::size_t at = 0; at < receive_.size(); at += kPerNode) {
     const double* x = &receive_[at];
     const auto i = static_cast<std::size_t>(x[0]);
     if (present_[i] == 0) continue;
-    take(i, {x[1], x[2], x[3]}, {x[4], x[5], x[6]});
+    take(i, {x[1], x[2], x[3]}, {x[4], x[5], x[6]}, finite, drift);
     motion(i, {x[7], x[8], x[9]}, x[10] != 0.0);
   }
+  drift_ = drift;
   return finite;
 }
 
