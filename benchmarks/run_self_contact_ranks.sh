@@ -9,7 +9,8 @@
 # ROUNDS (default 3), NODES (default 1024).
 # A step's cost is (wall(120) − wall(60)) / 60 of runs with one frame each, the least over the
 # rounds: the first step, which builds the candidate lists, and the start-up cancel.
-# Writes benchmarks/results/self-contact-ranks-<host>-<date>.md.
+# Writes benchmarks/results/self-contact-ranks-<host>-<date>.md (-2, -3, ... for later runs of
+# the day).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 builds=("$@")
@@ -61,7 +62,12 @@ for ((round = 0; round < rounds; ++round)); do
 done
 
 date=$(date -u +%Y-%m-%d)
-out=benchmarks/results/self-contact-ranks-$(hostname -s)-$date.md
+stem=benchmarks/results/self-contact-ranks-$(hostname -s)-$date
+out=$stem.md
+for ((i = 2; ; ++i)); do  # a later run of the day beside the earlier ones
+  [[ -e $out ]] || break
+  out=$stem-$i.md
+done
 {
   echo "# Self-contact's cost on several ranks, $date"
   echo
