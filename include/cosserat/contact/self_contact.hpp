@@ -45,8 +45,8 @@ class SelfContact {
                            const std::vector<char>& held, NodeVelocities& corrected,
                            std::vector<char>* moved_rows);
 
-  // How many nodes' state of the last step this rank held: its own and those of other ranks
-  // within reach of them (all of them on one rank).
+  // How many nodes' state of the step this rank holds: its own and those other ranks sent it
+  // when it last built its candidate lists (all of them on one rank).
   std::size_t nodes_held() const { return present_nodes_.size(); }
 
   // About what one rank holds for an m x n grid: arrays over the whole grid for the state of
