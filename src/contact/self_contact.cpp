@@ -177,9 +177,9 @@ bool SelfContact::on_floor(const Vec3& x) const {
 // corners' boxes; two edges' nearest points are within t at the step's end, or met within t
 // of both edges during it, and each node lies within an edge's extent of them. D is at most
 // the largest extent of a cell's corners at the step's start plus twice the farthest any node
-// moves in a coordinate. So each rank sends another the nodes whose box lies within
-// kHops (2t + margin + 2D) of the other's box of nodes. Whether every position is finite, on
-// every rank.
+// moves in a coordinate. So a rank needs the nodes whose box lies within the reach
+// R = kHops (2t + margin + 2D) of its own nodes' box, and is sent those within kSpare R.
+// Whether every position is finite, on every rank.
 bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                          const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
                          const std::vector<char>& held) {
