@@ -44,7 +44,10 @@ trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1
 # Open MPI's choice of collective algorithms: with SMPI's defaults, building a 256-rank run
 # took 33-52 s of SimGrid's time, with these 0.9 s.
-smpi=(smpirun --cfg=smpi/coll-selector:ompi --log=root.thres:warning -platform "$platform")
+# Folded memory is mapped in blocks of 64 MiB rather than SimGrid's 1 MiB: 1024 ranks of 1024²
+# nodes needed more maps than Linux allows a process (vm.max_map_count, 65530) and stopped.
+smpi=(smpirun --cfg=smpi/coll-selector:ompi --cfg=smpi/shared-malloc-blocksize:67108864
+  --log=root.thres:warning -platform "$platform")
 
 calibrate() {  # the one-core step of each block size, into $1
   echo "block,nodes,steps,seconds_per_step,ns_per_node_step" >"$1"
