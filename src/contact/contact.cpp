@@ -1784,6 +1784,35 @@ bool Contact::any_inside(int pass, const Field<Vec3>& next, double& penetration)
   return any != 0;
 }
 
+bool Contact::any_moving() const {
+  return std::any_of(solids_.begin(), solids_.end(),
+                     [](const Solid& s) { return s.spec.motion != SolidMotion::fixed; });
+}
+
+// A bounded solid's surface lies within its ball about its frame's origin, grown by the offset,
+// and moves at most |v| + |ω| R there; a plane pushes only along its normal, and turning it moves
+// the points over the box by at most |ω| times their farthest from its point.
+double Contact::approach_step(const Vec3& lo, const Vec3& hi, double reach) const {
+  double step = kHuge;
+  for (const Solid& s : solids_) {
+    if (s.spec.motion == SolidMotion::fixed) continue;
+    const SolidState& now = s.state;
+    const Vec3& p = now.pose.position;
+    double gap = 0.0, speed = 0.0;
+    if (s.spec.shape.kind == ShapeKind::plane) {
+      const Vec3 n = now.pose.direction_to_world({0.0, 0.0, 1.0});
+      gap = lowest_along(n, lo, hi) - dot(n, p) - s.spec.thickness;
+      speed = std::abs(dot(now.velocity, n)) + norm(now.angular_velocity) * farthest_in(p, lo, hi);
+    } else {
+      const double radius = s.geometry.bounding_radius() + s.spec.thickness;
+      gap = box_gap(p, p, lo, hi) - radius;
+      speed = norm(now.velocity) + norm(now.angular_velocity) * radius;
+    }
+    if (speed > 0.0) step = std::min(step, (std::max(gap, 0.0) + reach) / speed);
+  }
+  return step;
+}
+
 void Contact::propose(double time, double dt) {
   shift_.assign(solids_.size(), 0.0);
   turn_.assign(solids_.size(), 0.0);

@@ -23,7 +23,7 @@ double stability_estimate(const Scene& scene, const StateMeasures& state) {
   double estimate = stretched_step_estimate(scene.model_spec(), state.stretch2);
   if (state.max_speed > 0.0)
     estimate = std::min(estimate, 0.25 * std::min(scene.h1(), scene.h2()) / state.max_speed);
-  return estimate;
+  return std::min(estimate, state.solid_step);
 }
 
 AdaptiveSteps::AdaptiveSteps(const Scene& scene, double scale)

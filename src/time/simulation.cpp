@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <vector>
 
@@ -316,10 +317,17 @@ StateMeasures Simulation::state_measures() {
   const Field<Vec3>& v = stepper_.velocities();
   const double inverse_h1_2 = 1.0 / (scene_->h1() * scene_->h1());
   const double inverse_h2_2 = 1.0 / (scene_->h2() * scene_->h2());
+  // The cloth's box only where a solid moves: approach_step reads it.
+  const bool boxed = contact_ && contact_->any_moving();
   // Each edge is read by the rank and thread that own its first node, and maxima are exact, so
   // the result is the same for any decomposition.
   double stretch2 = 0.0, speed2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : stretch2, speed2)
+  constexpr double kNone = -std::numeric_limits<double>::infinity();
+  double lo_x = kNone, lo_y = kNone, lo_z = kNone;  // −(the box's low corner)
+  double hi_x = kNone, hi_y = kNone, hi_z = kNone;
+#pragma omp parallel for schedule(static) \
+    reduction(max                         \
+              : stretch2, speed2, lo_x, lo_y, lo_z, hi_x, hi_y, hi_z)
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k) {
       const Vec3 p = r(k, l);
@@ -332,12 +340,25 @@ StateMeasures Simulation::state_measures() {
         stretch2 = std::max(stretch2, dot(e, e) * inverse_h2_2);
       }
       speed2 = std::max(speed2, dot(v(k, l), v(k, l)));
+      if (boxed) {
+        lo_x = std::max(lo_x, -p.x);
+        lo_y = std::max(lo_y, -p.y);
+        lo_z = std::max(lo_z, -p.z);
+        hi_x = std::max(hi_x, p.x);
+        hi_y = std::max(hi_y, p.y);
+        hi_z = std::max(hi_z, p.z);
+      }
     }
-  // Both maxima in one reduction: it runs before every adaptive step.
-  const double local[2] = {stretch2, speed2};
-  double global[2] = {stretch2, speed2};
-  MPI_Allreduce(local, global, 2, MPI_DOUBLE, MPI_MAX, b.comm);
-  return StateMeasures{global[0], std::sqrt(global[1])};
+  // Every maximum in one reduction: it runs before every adaptive step.
+  const double local[8] = {stretch2, speed2, lo_x, lo_y, lo_z, hi_x, hi_y, hi_z};
+  double global[8];
+  MPI_Allreduce(local, global, boxed ? 8 : 2, MPI_DOUBLE, MPI_MAX, b.comm);
+  StateMeasures measures{global[0], std::sqrt(global[1])};
+  if (boxed)
+    measures.solid_step = contact_->approach_step({-global[2], -global[3], -global[4]},
+                                                  {global[5], global[6], global[7]},
+                                                  0.25 * std::min(scene_->h1(), scene_->h2()));
+  return measures;
 }
 
 }  // namespace cosserat

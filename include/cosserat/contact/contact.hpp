@@ -100,6 +100,14 @@ class Contact {
   bool wide_walk() const { return wide_walk_; }
   void set_wide_walk(bool wide) { wide_walk_ = wide && wide_copies_available(); }
 
+  // Whether a solid moves (kinematic or free).
+  bool any_moving() const;
+  // The longest step over which no moving solid, at its speed at the last accepted time, brings
+  // its surface more than `reach` into the box [lo, hi] of the cloth's nodes: the least over
+  // those solids of (gap + reach) / speed, the speed bounding every point of the surface that
+  // can meet the box; +∞ with none moving (docs/stability.md, "Adaptive steps").
+  double approach_step(const Vec3& lo, const Vec3& hi, double reach) const;
+
   // The proposed step was accepted: the solids take their proposed state.
   void accept();
   // How many tile bands the next walk finds far from every solid (docs/contact.md, "Cost").

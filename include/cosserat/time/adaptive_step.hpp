@@ -5,19 +5,25 @@
 // (docs/stability.md) trips and the run rolls back. Every choice is made from
 // global maxima, which are exact, so the steps are the same on any number of ranks.
 
+#include <limits>
+
 #include "cosserat/scene/scene.hpp"
 
 namespace cosserat {
 
-// What the estimate reads from the current state; both global maxima.
+// What the estimate reads from the current state, from global maxima.
 struct StateMeasures {
   double stretch2 = 1.0;   // the largest |r_,α|² / |R_,α|² over the grid's edges
   double max_speed = 0.0;  // m/s
+  // The longest step in which no moving solid comes more than a quarter of the smaller spacing
+  // into the box of the cloth's nodes (Contact::approach_step), s.
+  double solid_step = std::numeric_limits<double>::infinity();
 };
 
 // The step the state allows, before the safety factor: the force model's for its stretched
-// edges (stretched_step_estimate, model/model_spec.hpp), and no more than a quarter of the
-// smaller spacing per step at the fastest node (half of what the monitor allows).
+// edges (stretched_step_estimate, model/model_spec.hpp), no more than a quarter of the smaller
+// spacing per step at the fastest node (half of what the monitor allows), and the moving
+// solids' `solid_step`.
 double stability_estimate(const Scene& scene, const StateMeasures& state);
 
 class AdaptiveSteps {
