@@ -44,7 +44,7 @@ fi
 ((self_contact)) && stem=${stem/hard-cases-/hard-cases-self-contact-}
 ((quick)) && stem=$stem-quick
 export COSSERAT OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
-export HARD_TIMEOUT=${HARD_TIMEOUT:-1200} QUICK=$quick
+export HARD_TIMEOUT=${HARD_TIMEOUT:-1200} QUICK=$quick SELF_CONTACT=$self_contact
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export WORK=$work
@@ -68,11 +68,10 @@ run_one() {  # index label scene steps extra discretisation
   local out=$WORK/$i-$disc
   local model=(--set model.discretisation="\"$disc\"")
   [[ $disc == mass-spring ]] && model=(--set 'model={kind="mass-spring", match="material"}')
-  if [[ $disc == self-contact ]]; then
-    model=(--set 'self_contact={}')
-    grep -q '^preset *=' "$scene" || [[ $extra == *preset* ]] ||
-      model+=(--set material.thickness=0.0005)
-  fi
+  local with=(--set 'self_contact={}')
+  grep -q '^preset *=' "$scene" || [[ $extra == *preset* ]] ||
+    with+=(--set material.thickness=0.0005)
+  [[ $disc == self-contact ]] && model=("${with[@]}")
   local args=(run "$scene" -q -o "$out.h5" --summary "$out.json" "${model[@]}"
     --set time.steps="$steps" --set time.output_every="$every")
   [[ -n $extra ]] && args+=(--set "$extra")
@@ -81,11 +80,18 @@ run_one() {  # index label scene steps extra discretisation
   timeout "$HARD_TIMEOUT" "$COSSERAT" "${args[@]}" >/dev/null 2>"$out.err" || rc=$?
   local wall
   wall=$(echo "$(date +%s.%N) - $t0" | bc)
-  # With self-contact, the pairs closer than half the cloth's thickness too (from the summary).
-  local thickness
-  thickness=$(/usr/bin/python3 -c "import json,sys
+  # With --self-contact, the pairs closer than half the cloth's thickness too, in the runs with
+  # and without it: the thickness self-contact takes, from the summary of a one-step run with it.
+  local thickness=""
+  if ((SELF_CONTACT)); then
+    local probe=(run "$scene" -q -o "$out.probe.h5" --summary "$out.probe.json" "${with[@]}"
+      --set time.steps=1 --set time.output_every=1)
+    [[ -n $extra ]] && probe+=(--set "$extra")
+    "$COSSERAT" "${probe[@]}" >/dev/null 2>&1 || true
+    thickness=$(/usr/bin/python3 -c "import json,sys
 try: print((json.load(open(sys.argv[1])).get('self_contact') or {}).get('thickness') or '')
-except Exception: print('')" "$out.json")
+except Exception: print('')" "$out.probe.json")
+  fi
   /usr/bin/python3 tools/sheet_quality.py "$out.h5" --json ${thickness:+--thickness "$thickness"} \
     >"$out.q.json" 2>>"$out.err" || true
   /usr/bin/python3 - "$out" "$i" "$label" "$disc" "$rc" "$wall" "$steps" <<'PY'
@@ -194,8 +200,9 @@ lines = [f"# Hard cases: {title}, {date}" + (" (QUICK: 1/10 of every run)" if qu
          "run stopped by the monitor): tools/sheet_quality.py. \"min far distance / h\": "
          "the smallest distance of two nodes more than 3 indices apart, where one is within h; "
          "\"most pairs < h/2\": the most such pairs closer than h/2 in one frame; "
-         "\"most pairs < t/2\": the same closer than half the cloth's thickness t, with "
-         "self-contact only (t from the run's summary); "
+         "\"most pairs < t/2\": the same closer than half the cloth's thickness t (with "
+         "--self-contact, in the runs with and without it; t the thickness self-contact takes: "
+         "the preset's, else 0.5 mm); "
          "\"most crossing triangle pairs\": the most pairs of the sheet's triangles that pass "
          "through each other in one frame (an exact test), with the cells they lie in. Exit 3: the "
          "stability monitor stopped the run (message). Wall time includes writing frames.", "",
