@@ -14,7 +14,8 @@ quadrature"): mu0 h1 h2 times the node's share of the dual area (1 inside, 1/2 o
 1/4 at a corner) in the default energy form, mu0 h1 h2 at every node in energy-nodal, M / (m n)
 in flux and in the mass-spring model; mu0 from the scene's material.mass (or density), or for a
 preset read back from the run summary's gravitational energy (--summary).
---table prints about 25 frames.
+--table prints about 25 frames. --from T counts the rises only from time T on (after moving fixes,
+loads or solids have stopped doing work).
 """
 
 import argparse
@@ -63,6 +64,8 @@ def main():
     ap.add_argument("h5")
     ap.add_argument("--summary", help="the run's --summary file (for a preset's mass)")
     ap.add_argument("--table", action="store_true", help="print about 25 frames")
+    ap.add_argument("--from", dest="start", type=float, default=0.0,
+                    help="count the rises of the total energy from this time on (s)")
     args = ap.parse_args()
     with h5py.File(args.h5, "r") as f:
         r = f["/positions"][:]
@@ -87,7 +90,8 @@ def main():
         d = np.linalg.norm(r[i] - r[i - 1], axis=-1)
         move[i] = d.max()
         kinetic_moved[i] = 0.5 * (mass * (d / (t[i] - t[i - 1])) ** 2).sum()
-    rise = np.diff(total)
+    counted = t[1:] > args.start
+    rise = np.where(counted, np.diff(total), -np.inf)
     risen = rise > 1e-12 * np.abs(total).max()
     peak = kinetic.max()
     speed_end = move[-1] / (t[-1] - t[-2]) if frames > 1 else 0.0
@@ -97,8 +101,9 @@ def main():
           f"{kinetic_moved[-1]:.3g} J")
     print(f"  at the end: largest stored speed {np.linalg.norm(v[-1], axis=-1).max():.3g} m/s, "
           f"largest move over the last frame {move[-1]:.3g} m ({speed_end:.3g} m/s)")
-    print(f"  total energy rose in {int(risen.sum())} of {frames - 1} frames, at most "
-          f"{rise.max():.3g} J" + (f" (t = {t[1 + rise.argmax()]:.3g} s)" if frames > 1 else ""))
+    since = f" after t = {args.start:.4g} s" if args.start > 0.0 else ""
+    print(f"  total energy rose in {int(risen.sum())} of {int(counted.sum())} frames{since}, at "
+          f"most {rise.max():.3g} J" + (f" (t = {t[1 + rise.argmax()]:.3g} s)" if counted.any() else ""))
     if args.table:
         for i in range(0, frames, max(1, frames // 25)):
             print(f"  t = {t[i]:8.3f}  kinetic {kinetic[i]:.3e}  from motion "

@@ -134,6 +134,7 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   end_.resize(nodes);
   velocity_.resize(nodes);
   inverse_mass_.resize(nodes);
+  slide_inverse_mass_.resize(nodes);
   node_inverse_mass_.resize(nodes);
   for (int l = 0; l < block.n; ++l)
     for (int k = 0; k < block.m; ++k)
@@ -347,10 +348,15 @@ void SelfContact::present_cells() {
   }
 }
 
-// A node's velocity and inverse mass for the response: none for a held node or one on a floor.
+// A node's velocity and inverse masses for the response: none for a held node; none across the
+// layers for one on a floor, which the floor holds that way, but its own along them, where the
+// floor's friction does not hold it: as immovable there too, a node sliding on the floor
+// dragged the layer above by friction with no reaction, and fed energy into it
+// (docs/contact.md, "Self-contact").
 void SelfContact::motion(std::size_t i, const Vec3& velocity, bool held) {
   velocity_[i] = velocity;
-  inverse_mass_[i] = held || on_floor(end_[i]) ? 0.0 : node_inverse_mass_[i];
+  slide_inverse_mass_[i] = held ? 0.0 : node_inverse_mass_[i];
+  inverse_mass_[i] = held || on_floor(end_[i]) ? 0.0 : slide_inverse_mass_[i];
 }
 
 // Edge number e's two nodes, k + m l (SelfContact::border_edges_).
@@ -824,22 +830,22 @@ Vec3 SelfContact::across(const Pair& q, const std::vector<Vec3>& x) const {
   return sum;
 }
 
-double SelfContact::inverse_mass(const Pair& q) const {
+double SelfContact::inverse_mass(const Pair& q, const std::vector<double>& inverse) const {
   double sum = 0.0;
   for (int i = 0; i < 4; ++i)
-    sum += q.weights[i] * q.weights[i] * inverse_mass_[static_cast<std::size_t>(q.nodes[i])];
+    sum += q.weights[i] * q.weights[i] * inverse[static_cast<std::size_t>(q.nodes[i])];
   return sum;
 }
 
 // Adds the pair's `amount` (a move or an impulse, per unit of inverse mass) along
-// `sign` × `direction` to each of its nodes' `sums`, by weight and inverse mass, with the node's
-// share in the pair.
+// `sign` × `direction` to each of its nodes' `sums`, by weight and `inverse` mass, with the
+// node's share in the pair.
 void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec3& direction,
-                            std::vector<Vec3>& sums) {
+                            const std::vector<double>& inverse, std::vector<Vec3>& sums) {
   for (int i = 0; i < 4; ++i) {
     const auto node = static_cast<std::size_t>(q.nodes[i]);
     if (share_[node] == 0.0) pending_.push_back(q.nodes[i]);
-    sums[node] += (q.share * amount * q.weights[i] * inverse_mass_[node] * sign) * direction;
+    sums[node] += (q.share * amount * q.weights[i] * inverse[node] * sign) * direction;
     share_[node] += q.share * std::abs(q.weights[i]);
     if (touched_[node] == 0) moved_.push_back(q.nodes[i]);
     touched_[node] = 1;
@@ -869,7 +875,7 @@ void SelfContact::separate() {
       const double depth = thickness_ - q.side * dot(q.normal, across(q, end_));
       if (!(depth > 0.0)) continue;
       any = true;
-      share_out(q, depth / q.stiffness, q.side, q.normal, move_);
+      share_out(q, depth / q.stiffness, q.side, q.normal, inverse_mass_, move_);
     }
     if (!any) break;
     take_means(move_, [&](std::size_t i, const Vec3& move) { end_[i] += move; });
@@ -889,7 +895,7 @@ void SelfContact::stop_approach_and_slide(double dt) {
       any = true;
       const double impulse = approach / q.stiffness;
       q.impulse += q.share * impulse;
-      share_out(q, impulse, q.side, q.normal, kick_);
+      share_out(q, impulse, q.side, q.normal, inverse_mass_, kick_);
     }
     if (!any) break;
     take_means(kick_, [&](std::size_t i, const Vec3& kick) { velocity_[i] += kick; });
@@ -901,9 +907,11 @@ void SelfContact::stop_approach_and_slide(double dt) {
     const Vec3 slide = relative - dot(relative, q.normal) * q.normal;
     const double speed = norm(slide);
     if (!(speed > 0.0)) continue;
-    // Stick where μ times the normal impulse suffices, else slide with the largest.
-    const double impulse = std::min(speed / q.stiffness, friction_ * q.impulse / q.share);
-    share_out(q, -impulse, 1.0, slide / speed, kick_);
+    // Stick where μ times the normal impulse suffices, else slide with the largest; the
+    // nodes on a floor take their share.
+    const double stiffness = inverse_mass(q, slide_inverse_mass_);
+    const double impulse = std::min(speed / stiffness, friction_ * q.impulse / q.share);
+    share_out(q, -impulse, 1.0, slide / speed, slide_inverse_mass_, kick_);
   }
   take_means(kick_, [&](std::size_t i, const Vec3& kick) {
     velocity_[i] += kick;
@@ -938,7 +946,7 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
                     static_cast<std::size_t>(k - b.k0)] != 0);
       }
   // A pair between held nodes only moves nothing.
-  for (Pair& q : pairs_) q.stiffness = inverse_mass(q);
+  for (Pair& q : pairs_) q.stiffness = inverse_mass(q, inverse_mass_);
   std::erase_if(pairs_, [](const Pair& q) { return !(q.stiffness > 0.0); });
   if (!pairs_.empty()) {
     separate();

@@ -40,11 +40,12 @@ inline Vec3 folded(const Scene& s, int k, int l, double base, double gap) {
 inline int row_above(const Scene& s, int l) { return s.n - 1 - l; }
 
 // Writes the folded state into the run on its block, ghosts included: the top layer (rows from
-// n/2 + 1) moving at `top_velocity`, the rest at rest. The Verlet family carries r⁻, the
-// velocity schemes v; velocity-verlet's stored acceleration stays that of the flat sheet, the
-// same on every decomposition.
+// n/2 + 1) moving at `top_velocity`, the bottom one (rows below n/2) at `bottom_velocity`, the
+// fold's top row at rest. The Verlet family carries r⁻, the velocity schemes v;
+// velocity-verlet's stored acceleration stays that of the flat sheet, the same on every
+// decomposition.
 inline void fold(Simulation& sim, const Scene& s, double base, double gap,
-                 const Vec3& top_velocity) {
+                 const Vec3& top_velocity, const Vec3& bottom_velocity = {}) {
   Stepper& stepper = sim.stepper();
   const auto fields = stepper.state_fields();
   Field<Vec3>& r = *fields.at(0).field;
@@ -54,7 +55,7 @@ inline void fold(Simulation& sim, const Scene& s, double base, double gap,
   for (int l = std::max(0, b.l0 - b.ghost); l < std::min(s.n, b.l1 + b.ghost); ++l)
     for (int k = std::max(0, b.k0 - b.ghost); k < std::min(s.m, b.k1 + b.ghost); ++k) {
       r(k, l) = folded(s, k, l, base, gap);
-      const Vec3 v = l > s.n / 2 ? top_velocity : Vec3{};
+      const Vec3 v = l > s.n / 2 ? top_velocity : l < s.n / 2 ? bottom_velocity : Vec3{};
       second(k, l) = carries_velocity ? v : r(k, l) - s.dt * v;
     }
   stepper.resume(0);

@@ -88,9 +88,9 @@ class SelfContact {
   void find_pairs();
   void find_edge_pairs();
   Vec3 across(const Pair& q, const std::vector<Vec3>& x) const;
-  double inverse_mass(const Pair& q) const;
+  double inverse_mass(const Pair& q, const std::vector<double>& inverse) const;
   void share_out(const Pair& q, double amount, double sign, const Vec3& direction,
-                 std::vector<Vec3>& sums);
+                 const std::vector<double>& inverse, std::vector<Vec3>& sums);
   template <class Take>
   void take_means(std::vector<Vec3>& sums, Take take);
   void separate();
@@ -125,6 +125,7 @@ class SelfContact {
   // Arrays over the whole grid, k + m l; only the nodes held are read.
   std::vector<Vec3> start_, end_, velocity_;
   std::vector<double> inverse_mass_;       // this step's: none for a held node or one on a floor
+  std::vector<double> slide_inverse_mass_;  // along the layers (friction): none for a held node
   std::vector<double> node_inverse_mass_;  // 1 / m of every node
   std::vector<Vec3> move_, kick_;
   std::vector<double> share_;
