@@ -401,20 +401,11 @@ TEST(DecompositionInvariance, ContactOnOneFloorFollowsTheOneBlockRun) {
 
 // testing::layered_sheet with `rows` rows at its spacing, on a floor, under gravity, 1e-4 s steps.
 Scene layers_on_a_floor(int rows, Integrator integrator, long steps) {
-  Scene scene = testing::layered_sheet(2e-3);
+  Scene scene = testing::layers_over_a_floor(2e-3, 0.3);
   scene.n = rows;
   scene.size2 = 0.05 * (rows - 1);
   scene.integrator = integrator;
-  scene.dt = 1e-4;
   scene.steps = steps;
-  scene.gravity = {0.0, -9.81, 0.0};
-  SolidSpec floor;
-  floor.name = "floor";
-  floor.shape.kind = ShapeKind::plane;
-  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
-  floor.thickness = 1e-3;
-  floor.friction = 0.3;
-  scene.solids.push_back(floor);
   return scene;
 }
 

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <string>
 
+#include "cosserat/contact/geometry.hpp"
 #include "cosserat/time/simulation.hpp"
 #include "support/sheets.hpp"
 
@@ -24,6 +25,22 @@ inline Scene layered_sheet(double thickness) {
   s.material.thickness = thickness;
   s.self_contact = SelfContactSpec{thickness, 0.3};
   s.dt = 2e-5;
+  return s;
+}
+
+// The layered sheet under gravity in 1e-4 s steps, over a floor: the plane y = 0 with an offset
+// of 1 mm (where fold(sim, s, 1e-3, ...) lays the bottom layer) and `friction`.
+inline Scene layers_over_a_floor(double thickness, double friction) {
+  Scene s = layered_sheet(thickness);
+  s.dt = 1e-4;
+  s.gravity = {0.0, -9.81, 0.0};
+  SolidSpec floor;
+  floor.name = "floor";
+  floor.shape.kind = ShapeKind::plane;
+  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
+  floor.thickness = 1e-3;
+  floor.friction = friction;
+  s.solids.push_back(floor);
   return s;
 }
 

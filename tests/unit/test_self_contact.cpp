@@ -159,17 +159,8 @@ Energies energies(Simulation& sim) {
 // stack chattered by a micrometre a step and rose by up to 2e-4 of the peak.)
 TEST(SelfContact, LayersOnAFloorStayApartAndLoseEnergy) {
   const double thickness = 2e-3;
-  Scene s = testing::layered_sheet(thickness);
-  s.dt = 1e-4;
-  s.gravity = {0.0, -9.81, 0.0};
+  Scene s = testing::layers_over_a_floor(thickness, 0.3);
   s.damping = 2.0;
-  SolidSpec floor;
-  floor.name = "floor";
-  floor.shape.kind = ShapeKind::plane;
-  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
-  floor.friction = 0.3;
-  floor.thickness = 1e-3;
-  s.solids.push_back(floor);
   Simulation sim(s, MPI_COMM_SELF);
   testing::fold(sim, s, 1e-3, s.h2(), {});
   Energies last = energies(sim);
@@ -196,16 +187,7 @@ TEST(SelfContact, LayersOnAFloorStayApartAndLoseEnergy) {
 // the momentum grew by 51 %, which fed the chatter of the napkin's creases (docs/contact.md,
 // "Self-contact").
 TEST(SelfContact, ALayerSlidingOnAFloorDragsTheOneAboveAndKeepsItsMomentum) {
-  Scene s = testing::layered_sheet(2e-3);
-  s.dt = 1e-4;
-  s.gravity = {0.0, -9.81, 0.0};
-  SolidSpec floor;
-  floor.name = "floor";
-  floor.shape.kind = ShapeKind::plane;
-  floor.pose.orientation = rotation_between({0.0, 0.0, 1.0}, {0.0, 1.0, 0.0});
-  floor.friction = 0.0;
-  floor.thickness = 1e-3;
-  s.solids.push_back(floor);
+  const Scene s = testing::layers_over_a_floor(2e-3, 0.0);
   Simulation sim(s, MPI_COMM_SELF);
   testing::fold(sim, s, 1e-3, s.h2(), {}, {0.5, 0.0, 0.0});
   const Block& b = sim.block();
