@@ -12,7 +12,7 @@
 #   APPEND       1: add the runs to the studies' logs of the day instead of starting them afresh
 # The simulation runs every rank's steps on this machine, one after another, on folded memory:
 # about 0.9 us a node to build a run and 0.2 us a node-step, so 1024² a rank on 1024 ranks
-# takes about half an hour, and each rank count of strong-16384 10-15 minutes.
+# took an hour here beside other work, and each rank count of strong-16384 10-15 minutes.
 # 1. Builds benchmarks/smpi with smpicxx (Debian: libsimgrid-dev, simgrid) into build/smpi.
 # 2. Calibrates: the one-core step of a B x B block, B = 128 ... 4096, timed on this machine (one
 #    simulated rank computing for real), as ns a node-step.
