@@ -61,8 +61,8 @@ inline int row_above(const Scene& s, int l) { return s.n - 1 - l; }
 // fold's top row at rest. The Verlet family carries r⁻, the velocity schemes v;
 // velocity-verlet's stored acceleration stays that of the flat sheet, the same on every
 // decomposition.
-inline void fold(Simulation& sim, const Scene& s, double base, double gap,
-                 const Vec3& top_velocity, const Vec3& bottom_velocity = {}) {
+inline void fold(Simulation& sim, const Scene& s, double base, double gap, const Vec3& top_velocity,
+                 const Vec3& bottom_velocity = {}) {
   Stepper& stepper = sim.stepper();
   const auto fields = stepper.state_fields();
   Field<Vec3>& r = *fields.at(0).field;
