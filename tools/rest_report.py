@@ -1,12 +1,15 @@
 #!/usr/bin/env python3
 """Whether a run came to rest (docs/contact.md, "Resting contact").
 
-    /usr/bin/python3 tools/rest_report.py OUT.h5 [--summary OUT.json] [--table]
+    /usr/bin/python3 tools/rest_report.py OUT.h5 [--summary OUT.json] [--table] [--from T]
 
 From the frames of OUT.h5 (docs/output.md; the `velocity` and `energy_density` fields):
 the kinetic energy from the stored velocities, its peak and its last value over the peak; the
 same from the frames' own motion (|r_f - r_f-1| / dt between frames), which a velocity that
-says more than the nodes moved cannot match; the largest node move over the last frame; and the
+says more than the nodes moved cannot match, and which a swing faster than the frames also
+reads low (the napkin's crease swung at 7 kHz through micrometres, docs/contact.md
+"Self-contact": a run continued from a checkpoint with --set time.output_dt=<its step> tells the
+two apart); the largest node move over the last frame; and the
 total energy, kinetic + gravitational (-sum m g.r) + elastic (energy_density times the rest
 dual area), with the frames where it rose. Loads, moving solids and free bodies do work this
 total does not count. The node masses are the discretisation's (docs/model.md, "Energy
