@@ -81,16 +81,20 @@ run_one() {  # index label scene steps extra discretisation
   local wall
   wall=$(echo "$(date +%s.%N) - $t0" | bc)
   # With --self-contact, the pairs closer than half the cloth's thickness too, in the runs with
-  # and without it: the thickness self-contact takes, from the summary of a one-step run with it.
-  local thickness=""
+  # and without it: the thickness self-contact takes, from the run's summary, or for a run
+  # without it from that of a one-step run with it.
+  local thickness="" summary=$out.json
   if ((SELF_CONTACT)); then
-    local probe=(run "$scene" -q -o "$out.probe.h5" --summary "$out.probe.json" "${with[@]}"
-      --set time.steps=1 --set time.output_every=1)
-    [[ -n $extra ]] && probe+=(--set "$extra")
-    "$COSSERAT" "${probe[@]}" >/dev/null 2>&1 || true
+    if [[ $disc != self-contact ]]; then
+      summary=$out.probe.json
+      local probe=(run "$scene" -q -o "$out.probe.h5" --summary "$summary" "${with[@]}"
+        --set time.steps=1 --set time.output_every=1)
+      [[ -n $extra ]] && probe+=(--set "$extra")
+      "$COSSERAT" "${probe[@]}" >/dev/null 2>&1 || true
+    fi
     thickness=$(/usr/bin/python3 -c "import json,sys
 try: print((json.load(open(sys.argv[1])).get('self_contact') or {}).get('thickness') or '')
-except Exception: print('')" "$out.probe.json")
+except Exception: print('')" "$summary")
   fi
   /usr/bin/python3 tools/sheet_quality.py "$out.h5" --json ${thickness:+--thickness "$thickness"} \
     >"$out.q.json" 2>>"$out.err" || true
