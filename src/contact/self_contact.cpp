@@ -12,8 +12,8 @@ namespace cosserat {
 namespace {
 
 // Passes of the position and of the velocity correction (docs/contact.md, "Self-contact"):
-// each moves a node by the mean of what its pairs ask, which never overshoots where several
-// pairs press one node but leaves part of a shared correction to the next pass.
+// each moves a node by its pairs' relaxed moves, which never overshoots where several pairs
+// press one node but leaves part of a shared correction to the next pass.
 constexpr int kPasses = 8;
 
 // A node within this fraction of the thickness above a fixed plane's offset surface lies on it.
@@ -34,11 +34,12 @@ constexpr int kPerNode = 11;
 constexpr int kReach = 9;
 
 // How many pairs apart the response can carry a node's state to another's: each pass of the
-// positions and of the velocities moves a node by its pairs' means, one pair further each pass,
-// friction adds one, the statistics read a pair's other nodes after them, and a border edge's
-// pair reads the cells beside both edges. A node this many pairs from every node a rank owns
-// cannot change what the rank's nodes end the step with.
-constexpr int kHops = 2 * kPasses + 3;
+// positions and of the velocities moves a node by its pairs' moves, one pair further each pass,
+// friction adds one, a pair's relaxation reads the pairs of its nodes, the statistics read a
+// pair's other nodes after them, and a border edge's pair reads the cells beside both edges. A
+// node this many pairs from every node a rank owns cannot change what the rank's nodes end the
+// step with.
+constexpr int kHops = 2 * kPasses + 4;
 
 // A rank is sent the nodes within this many times the reach of its own, and builds its lists
 // again only when a node it does not hold comes within the reach itself.
@@ -143,6 +144,7 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   move_.resize(nodes);
   kick_.resize(nodes);
   share_.resize(nodes);
+  pending_mark_.assign(nodes, 0);
   touched_.assign(nodes, 0);
   const auto cells = static_cast<std::size_t>(block.m - 1) * static_cast<std::size_t>(block.n - 1);
   box_lo_.resize(cells);
@@ -839,35 +841,58 @@ double SelfContact::inverse_mass(const Pair& q, const std::vector<double>& inver
 
 // Adds the pair's `amount` (a move or an impulse, per unit of inverse mass) along
 // `sign` × `direction` to each of its nodes' `sums`, by weight and `inverse` mass, with the
-// node's share in the pair.
+// pair's share and relaxation. The weights sum to zero, so a pair's moves and impulses keep the
+// momentum of its nodes (a node that does not move takes what the others give).
 void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec3& direction,
                             const std::vector<double>& inverse, std::vector<Vec3>& sums) {
+  const double scale = q.share * q.relaxation * amount * sign;
   for (int i = 0; i < 4; ++i) {
     const auto node = static_cast<std::size_t>(q.nodes[i]);
-    if (share_[node] == 0.0) pending_.push_back(q.nodes[i]);
-    sums[node] += (q.share * amount * q.weights[i] * inverse[node] * sign) * direction;
-    share_[node] += q.share * std::abs(q.weights[i]);
+    if (pending_mark_[node] == 0) {
+      pending_mark_[node] = 1;
+      pending_.push_back(q.nodes[i]);
+    }
+    sums[node] += (scale * q.weights[i] * inverse[node]) * direction;
     if (touched_[node] == 0) moved_.push_back(q.nodes[i]);
     touched_[node] = 1;
   }
 }
 
-// Each node its pairs reached takes the mean of its `sums` by its shares (never more than one
-// pair's worth), and its sum and share are cleared.
+// Each pair's relaxation: 1 over the largest total share, over its moving nodes, of the pairs
+// they are in, so that all a node's pairs together never move it more than one pair's worth.
+// The same factor for all of a pair's nodes keeps action and reaction equal, which a node's mean
+// of its pairs' moves did not (docs/contact.md, "Self-contact", item 2).
+void SelfContact::relax() {
+  for (const Pair& q : pairs_)
+    for (int i = 0; i < 4; ++i)
+      share_[static_cast<std::size_t>(q.nodes[i])] += q.share * std::abs(q.weights[i]);
+  for (Pair& q : pairs_) {
+    double most = 1.0;
+    for (int i = 0; i < 4; ++i) {
+      const auto node = static_cast<std::size_t>(q.nodes[i]);
+      if (slide_inverse_mass_[node] > 0.0) most = std::max(most, share_[node]);
+    }
+    q.relaxation = 1.0 / most;
+  }
+  for (const Pair& q : pairs_)
+    for (int i = 0; i < 4; ++i) share_[static_cast<std::size_t>(q.nodes[i])] = 0.0;
+}
+
+// Each node its pairs reached takes its sum, which is cleared.
 template <class Take>
-void SelfContact::take_means(std::vector<Vec3>& sums, Take take) {
+void SelfContact::take_sums(std::vector<Vec3>& sums, Take take) {
   for (const std::int32_t node : pending_) {
     const auto i = static_cast<std::size_t>(node);
-    take(i, sums[i] / std::max(1.0, share_[i]));
+    take(i, sums[i]);
     sums[i] = {};
-    share_[i] = 0.0;
+    pending_mark_[i] = 0;
   }
   pending_.clear();
 }
 
 // Each pass moves every pair's node and triangle apart along the triangle's normal to the
-// thickness, in inverse proportion to their masses (a held node does not move), each node by
-// the mean of its pairs' moves weighted by its share in them.
+// thickness, in inverse proportion to their masses (a held node does not move), relaxed so that
+// no node moves more than one pair's worth.
 void SelfContact::separate() {
   for (int pass = 0; pass < kPasses; ++pass) {
     bool any = false;
@@ -878,7 +903,7 @@ void SelfContact::separate() {
       share_out(q, depth / q.stiffness, q.side, q.normal, inverse_mass_, move_);
     }
     if (!any) break;
-    take_means(move_, [&](std::size_t i, const Vec3& move) { end_[i] += move; });
+    take_sums(move_, [&](std::size_t i, const Vec3& move) { end_[i] += move; });
   }
 }
 
@@ -898,7 +923,7 @@ void SelfContact::stop_approach_and_slide(double dt) {
       share_out(q, impulse, q.side, q.normal, inverse_mass_, kick_);
     }
     if (!any) break;
-    take_means(kick_, [&](std::size_t i, const Vec3& kick) { velocity_[i] += kick; });
+    take_sums(kick_, [&](std::size_t i, const Vec3& kick) { velocity_[i] += kick; });
   }
   if (friction_ == 0.0) return;
   for (const Pair& q : pairs_) {
@@ -913,7 +938,7 @@ void SelfContact::stop_approach_and_slide(double dt) {
     const double impulse = std::min(speed / stiffness, friction_ * q.impulse / q.share);
     share_out(q, -impulse, 1.0, slide / speed, slide_inverse_mass_, kick_);
   }
-  take_means(kick_, [&](std::size_t i, const Vec3& kick) {
+  take_sums(kick_, [&](std::size_t i, const Vec3& kick) {
     velocity_[i] += kick;
     end_[i] += dt * kick;
   });
@@ -949,6 +974,7 @@ SelfContactStats SelfContact::respond(double dt, const Field<Vec3>& current, Fie
   for (Pair& q : pairs_) q.stiffness = inverse_mass(q, inverse_mass_);
   std::erase_if(pairs_, [](const Pair& q) { return !(q.stiffness > 0.0); });
   if (!pairs_.empty()) {
+    relax();
     separate();
     stop_approach_and_slide(dt);
     for (const Pair& q : pairs_)

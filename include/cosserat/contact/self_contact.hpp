@@ -70,6 +70,7 @@ class SelfContact {
                    // line from the triangle's nearest point where p's foot lies beside it
     double impulse = 0.0;    // the normal velocity impulse it gave, per unit of mass
     double stiffness = 0.0;  // the inverse of the mass it moves as one (inverse_mass)
+    double relaxation = 1.0;  // of its moves and impulses (relax)
   };
   // A cell's four triangles, node numbers k + m l: both diagonals' pairs, in the order of its
   // planes (planes_).
@@ -91,8 +92,9 @@ class SelfContact {
   double inverse_mass(const Pair& q, const std::vector<double>& inverse) const;
   void share_out(const Pair& q, double amount, double sign, const Vec3& direction,
                  const std::vector<double>& inverse, std::vector<Vec3>& sums);
+  void relax();
   template <class Take>
-  void take_means(std::vector<Vec3>& sums, Take take);
+  void take_sums(std::vector<Vec3>& sums, Take take);
   void separate();
   void stop_approach_and_slide(double dt);
 
@@ -128,7 +130,8 @@ class SelfContact {
   std::vector<double> slide_inverse_mass_;  // along the layers (friction): none for a held node
   std::vector<double> node_inverse_mass_;  // 1 / m of every node
   std::vector<Vec3> move_, kick_;
-  std::vector<double> share_;
+  std::vector<double> share_;  // a node's total share in the step's pairs (relax); else zero
+  std::vector<char> pending_mark_;
   std::vector<char> touched_;
   std::vector<std::int32_t> moved_;    // the nodes touched_ marks, in the order first reached
   std::vector<std::int32_t> pending_;  // the nodes with a share in this pass's sums
