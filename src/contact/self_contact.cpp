@@ -679,6 +679,7 @@ void SelfContact::find_pairs() {
     for (std::size_t at = 0; at < present_nodes_.size(); ++at) {
       const auto p = static_cast<std::size_t>(present_nodes_[at]);
       if (list_start_[p] == list_start_[p + 1]) continue;
+      const std::size_t first = found.size();
       Vec3 lo = start_[p], hi = lo;
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::min(lo[a], end_[p][a]) - t;
@@ -720,6 +721,7 @@ void SelfContact::find_pairs() {
           Foot on = at_end;
           double pair_side = side;
           Vec3 direction = normal;
+          bool beside = false;
           if (side * d1 < 0.0) {
             const double s = d0 / (d0 - d1);
             const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
@@ -729,6 +731,7 @@ void SelfContact::find_pairs() {
           } else if (!at_end.near(0.0)) {
             if (!at_end.near(slack)) continue;
             on = at_end.clamped();
+            beside = true;
             const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
             const double distance = norm(away);
             if (distance >= t) continue;
@@ -741,15 +744,48 @@ void SelfContact::find_pairs() {
                                {1.0, -on.a, -on.b, -on.c},
                                pair_side,
                                0.5,
-                               direction});
+                               direction,
+                               beside});
         }
       }
+      drop_covered(found, first);
     }
   }
   pairs_.clear();
   for (const std::vector<Pair>& found : thread_pairs_)
     pairs_.insert(pairs_.end(), found.begin(), found.end());
   find_edge_pairs();
+}
+
+// A pair of node p and a triangle beside which its foot lies pushes along the line from the
+// triangle's nearest point F. Where p also pairs along the normal with a triangle whose plane
+// has F on it or beyond it, away from p, the pair beside adds nothing: held t from that plane,
+// p is at least t from F. And it takes away: a node resting over a node of a flat layer below,
+// its foot in the triangles on one side and beside those on the other, was pushed along the
+// line from the node below, sideways as much as it stood off it, and rolled off it as off a
+// ball; with frictionless layers the napkin's stacked rows swung from node to node
+// (docs/contact.md, "Self-contact", item 1). Removes those pairs from p's, found[first...].
+void SelfContact::drop_covered(std::vector<Pair>& found, std::size_t first) {
+  const double level = kOnFloor * thickness_;
+  const auto covered = [&](const Pair& b) {
+    if (!b.beside) return false;
+    Vec3 nearest{};
+    for (int i = 1; i < 4; ++i)
+      nearest -= b.weights[i] * end_[static_cast<std::size_t>(b.nodes[i])];
+    for (std::size_t a = first; a < found.size(); ++a) {
+      const Pair& along = found[a];
+      if (along.beside) continue;
+      const Vec3& corner = end_[static_cast<std::size_t>(along.nodes[1])];
+      if (along.side * dot(along.normal, nearest - corner) <= level) return true;
+    }
+    return false;
+  };
+  // Only pairs beside are dropped and only pairs along a normal are read, so compacting in
+  // place reads every one of those.
+  std::size_t kept = first;
+  for (std::size_t a = first; a < found.size(); ++a)
+    if (!covered(found[a])) found[kept++] = found[a];
+  found.resize(kept);
 }
 
 // A border edge and another edge that cross over the step, or end it closer than the thickness,

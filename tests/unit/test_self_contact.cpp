@@ -95,6 +95,34 @@ TEST(SelfContact, ATriangleTurnedOverInAStepThrowsNoNode) {
   EXPECT_LE(highest, 1.01 * thickness);
 }
 
+// A node of the top layer pressed into the flat bottom layer over one of its nodes, a tenth of the
+// thickness off it along x: its foot lies in the bottom triangles on that side and beside those
+// on the other, whose nearest point is the node below. Held the thickness from the triangles'
+// plane it is that far from the node below too, so the layers are pushed apart along their
+// normal only, and no node of the flat bottom layer moves along it. (With a pair beside too,
+// pushing along the line from the node below, that node went 1.6e-5 m the other way: stacked
+// rows so rolled off each other's nodes, and the napkin's frictionless layers chattered;
+// docs/contact.md, "Self-contact", item 1.)
+TEST(SelfContact, ANodeOverANodeOfTheLayerBelowIsPushedAlongTheNormal) {
+  const double thickness = 2e-3, gap = 0.75 * thickness;
+  Scene s = testing::layered_sheet(thickness);
+  Simulation sim(s, MPI_COMM_SELF);
+  testing::fold(sim, s, 0.0, gap, {});
+  Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
+  Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+  const int k = 5, l = testing::row_above(s, 3);
+  r(k, l).x += 0.1 * thickness;
+  before(k, l).x += 0.1 * thickness;
+  sim.stepper().resume(0);
+  ASSERT_FALSE(sim.step());
+  EXPECT_GE(sim.positions()(k, l).y - sim.positions()(k, 3).y, 0.999 * thickness);
+  double most = 0.0;
+  for (int lb = 1; lb <= 5; ++lb)
+    for (int kb = k - 2; kb <= k + 2; ++kb)
+      most = std::max(most, std::abs(sim.positions()(kb, lb).x - kb * s.h1()));
+  EXPECT_LT(most, 1e-12) << "a node of the bottom layer moved along it";
+}
+
 // Two border edges crossed like the bars of an X, 4 mm apart in a step where the thickness is
 // 1 mm: edge B, (4, 1)–(5, 1) along z, drops at 40 m/s through edge A, (0, 0)–(1, 0) along x.
 // A strip of 6 × 2 nodes with no stiffness holds them: A's cell hangs below it in the plane

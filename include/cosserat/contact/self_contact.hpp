@@ -68,6 +68,7 @@ class SelfContact {
     double share;  // of the cell's two diagonals for a node; 1 for two edges
     Vec3 normal;   // the triangle's at the proposed step, or the edges' common normal, or the
                    // line from the triangle's nearest point where p's foot lies beside it
+    bool beside = false;     // a node whose foot lies beside the triangle (find_pairs)
     double impulse = 0.0;    // the normal velocity impulse it gave, per unit of mass
     double stiffness = 0.0;  // the inverse of the mass it moves as one (inverse_mass)
     double relaxation = 1.0;  // of its moves and impulses (relax)
@@ -87,6 +88,7 @@ class SelfContact {
   void cell_planes(std::size_t c);
   void build_candidates(double extent_sum);
   void find_pairs();
+  void drop_covered(std::vector<Pair>& found, std::size_t first);
   void find_edge_pairs();
   Vec3 across(const Pair& q, const std::vector<Vec3>& x) const;
   double inverse_mass(const Pair& q, const std::vector<double>& inverse) const;
