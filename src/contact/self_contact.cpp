@@ -758,11 +758,13 @@ void SelfContact::find_pairs() {
 }
 
 // A pair of node p and a triangle beside which its foot lies pushes along the line from the
-// triangle's nearest point F. Where p also pairs along the normal with a triangle whose plane
-// has F on it or beyond it, away from p, the pair beside adds nothing: held t from that plane,
-// p is at least t from F. And it takes away: a node resting over a node of a flat layer below,
-// its foot in the triangles on one side and beside those on the other, was pushed along the
-// line from the node below, sideways as much as it stood off it, and rolled off it as off a
+// triangle's nearest point F, on an edge or at a corner. Where p also pairs along the normal
+// with a triangle that holds that edge or corner, or whose plane holds F (to 1e-6 t: in a flat
+// layer, where F, found by cutting off the foot's negative coordinates, need not lie on the
+// edge the two triangles share), the pair beside adds nothing: held t from that triangle's
+// plane, p is at least t from F. And it takes away: a node resting over a node of a flat layer
+// below, its foot in the triangles on one side and beside those on the other, was pushed along
+// the line from the node below, sideways as much as it stood off it, and rolled off it as off a
 // ball; with frictionless layers the napkin's stacked rows swung from node to node
 // (docs/contact.md, "Self-contact", item 1). Removes those pairs from p's, found[first...].
 void SelfContact::drop_covered(std::vector<Pair>& found, std::size_t first) {
@@ -775,8 +777,12 @@ void SelfContact::drop_covered(std::vector<Pair>& found, std::size_t first) {
     for (std::size_t a = first; a < found.size(); ++a) {
       const Pair& along = found[a];
       if (along.beside) continue;
+      bool holds = true;
+      for (int i = 1; i < 4 && holds; ++i)
+        holds = b.weights[i] == 0.0 ||
+                std::find(along.nodes + 1, along.nodes + 4, b.nodes[i]) != along.nodes + 4;
       const Vec3& corner = end_[static_cast<std::size_t>(along.nodes[1])];
-      if (along.side * dot(along.normal, nearest - corner) <= level) return true;
+      if (holds || std::abs(dot(along.normal, nearest - corner)) <= level) return true;
     }
     return false;
   };

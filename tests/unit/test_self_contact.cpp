@@ -111,8 +111,9 @@ TEST(SelfContact, ANodeOverANodeOfTheLayerBelowIsPushedAlongTheNormal) {
   Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
   Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
   const int k = 5, l = testing::row_above(s, 3);
-  r(k, l).x += 0.1 * thickness;
-  before(k, l).x += 0.1 * thickness;
+  const Vec3 off{0.1 * thickness, 0.0, 0.05 * thickness};
+  r(k, l) += off;
+  before(k, l) += off;
   sim.stepper().resume(0);
   ASSERT_FALSE(sim.step());
   EXPECT_GE(sim.positions()(k, l).y - sim.positions()(k, 3).y, 0.999 * thickness);
