@@ -96,13 +96,14 @@ TEST(SelfContact, ATriangleTurnedOverInAStepThrowsNoNode) {
 }
 
 // A node of the top layer pressed into the flat bottom layer over one of its nodes, a tenth of the
-// thickness off it along x: its foot lies in the bottom triangles on that side and beside those
-// on the other, whose nearest point is the node below. Held the thickness from the triangles'
-// plane it is that far from the node below too, so the layers are pushed apart along their
-// normal only, and no node of the flat bottom layer moves along it. (With a pair beside too,
-// pushing along the line from the node below, that node went 1.6e-5 m the other way: stacked
-// rows so rolled off each other's nodes, and the napkin's frictionless layers chattered;
-// docs/contact.md, "Self-contact", item 1.)
+// thickness off it along x and a twentieth along z: its foot lies in the bottom triangles on
+// that side and beside the others round the node below, whose nearest points are at or near
+// that node. Held the thickness from the layer's plane it is that far from those points too,
+// so the layers are pushed apart along their normal only, and no node of the flat bottom layer
+// moves along it. (With the pairs beside kept, pushing along the lines from those points, the
+// bottom layer's nodes moved up to 1.6e-5 m along it: stacked rows so rolled off each other's
+// nodes, and the napkin's frictionless layers chattered; docs/contact.md, "Self-contact",
+// item 1.)
 TEST(SelfContact, ANodeOverANodeOfTheLayerBelowIsPushedAlongTheNormal) {
   const double thickness = 2e-3, gap = 0.75 * thickness;
   Scene s = testing::layered_sheet(thickness);
