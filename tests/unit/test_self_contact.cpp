@@ -64,6 +64,19 @@ TEST(SelfContact, ALayerFiredAtFiftyMetresASecondDoesNotTunnel) {
   }
 }
 
+// The layered sheet folded with its top layer at rest three quarters of the thickness above the
+// bottom one: pressed into it, for a test to move a node of either before the first step.
+class PressedLayers : public ::testing::Test {
+ protected:
+  PressedLayers() { testing::fold(sim, s, 0.0, gap, {}); }
+
+  const double thickness = 2e-3, gap = 0.75 * thickness;
+  const Scene s = testing::layered_sheet(thickness);
+  Simulation sim{s, MPI_COMM_SELF};
+  Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
+  Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+};
+
 // A cell of the bottom layer nearly collapsed, one node 0.03 spacings short of the far side of
 // two of its triangles, crosses it in one step: the triangles turn over, their normals at the
 // step's end point the other way, and the top layer's node over their corner, 0.75 thicknesses
@@ -72,13 +85,7 @@ TEST(SelfContact, ALayerFiredAtFiftyMetresASecondDoesNotTunnel) {
 // it. (Without that rule the node was pulled down here, to 1.47 mm against the others'
 // lift; in the crumple of scenes/hard a node so thrown moved more than half a spacing in a
 // step and stopped the run.)
-TEST(SelfContact, ATriangleTurnedOverInAStepThrowsNoNode) {
-  const double thickness = 2e-3, gap = 0.75 * thickness;
-  Scene s = testing::layered_sheet(thickness);
-  Simulation sim(s, MPI_COMM_SELF);
-  testing::fold(sim, s, 0.0, gap, {});
-  Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
-  Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+TEST_F(PressedLayers, ATriangleTurnedOverInAStepThrowsNoNode) {
   const int k = 5, l = 3;
   r(k, l) += Vec3{0.97 * s.h1(), 0.0, 0.0};
   before(k, l) = r(k, l) - Vec3{0.1 * s.h1(), 0.0, 0.0};
@@ -104,13 +111,7 @@ TEST(SelfContact, ATriangleTurnedOverInAStepThrowsNoNode) {
 // bottom layer's nodes moved up to 1.6e-5 m along it: stacked rows so rolled off each other's
 // nodes, and the napkin's frictionless layers chattered; docs/contact.md, "Self-contact",
 // item 1.)
-TEST(SelfContact, ANodeOverANodeOfTheLayerBelowIsPushedAlongTheNormal) {
-  const double thickness = 2e-3, gap = 0.75 * thickness;
-  Scene s = testing::layered_sheet(thickness);
-  Simulation sim(s, MPI_COMM_SELF);
-  testing::fold(sim, s, 0.0, gap, {});
-  Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
-  Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+TEST_F(PressedLayers, ANodeOverANodeOfTheLayerBelowIsPushedAlongTheNormal) {
   const int k = 5, l = testing::row_above(s, 3);
   const Vec3 off{0.1 * thickness, 0.0, 0.05 * thickness};
   r(k, l) += off;
