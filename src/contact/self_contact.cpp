@@ -758,13 +758,13 @@ void SelfContact::find_pairs() {
 }
 
 // A pair of node p and a triangle beside which its foot lies pushes along the line from the
-// triangle's nearest point F, on an edge or at a corner. Where p also pairs along the normal
-// with a triangle that holds that edge or corner, or whose plane holds F (to 1e-6 t: in a flat
-// layer F can lie on an edge that no triangle holding p's foot has), the pair beside adds
-// nothing: held t from that triangle's plane, p is at least t from F. And it takes away: a node resting over a node of a flat layer
-// below, its foot in the triangles on one side and beside those on the other, was pushed along
-// the line from the node below, sideways as much as it stood off it, and rolled off it as off a
-// ball; with frictionless layers the napkin's stacked rows swung from node to node
+// triangle's nearest point F, on an edge or at a corner. Where p also pairs along the normal with a
+// triangle that holds that edge or corner, or whose plane holds F (to 1e-6 t: in a flat layer F can
+// lie on an edge that no triangle holding p's foot has), the pair beside adds nothing: held t from
+// that triangle's plane, p is at least t from F. And it takes away: a node resting over a node of a
+// flat layer below, its foot in the triangles on one side and beside those on the other, was pushed
+// along the line from the node below, sideways as much as it stood off it, and rolled off it as off
+// a ball; with frictionless layers the napkin's stacked rows swung from node to node
 // (docs/contact.md, "Self-contact", item 1). Removes those pairs from p's, found[first...].
 void SelfContact::drop_covered(std::vector<Pair>& found, std::size_t first) {
   const double level = kOnFloor * thickness_;
