@@ -3,20 +3,20 @@
 
     /usr/bin/python3 tools/rest_report.py OUT.h5 [--summary OUT.json] [--table] [--from T]
 
-From the frames of OUT.h5 (docs/output.md; the `velocity` and `energy_density` fields):
-the kinetic energy from the stored velocities, its peak and its last value over the peak; the
-same from the frames' own motion (|r_f - r_f-1| / dt between frames), which a velocity that
-says more than the nodes moved cannot match, and which a swing faster than the frames also
-reads low (the napkin's crease swung at 7 kHz through micrometres, docs/contact.md
-"Self-contact": a run continued from a checkpoint with --set time.output_dt=<its step> tells the
-two apart); the largest node move over the last frame; and the
-total energy, kinetic + gravitational (-sum m g.r) + elastic (energy_density times the rest
-dual area), with the frames where it rose. Loads, moving solids and free bodies do work this
-total does not count. The node masses are the discretisation's (docs/model.md, "Energy
-quadrature"): mu0 h1 h2 times the node's share of the dual area (1 inside, 1/2 on a border,
-1/4 at a corner) in the default energy form, mu0 h1 h2 at every node in energy-nodal, M / (m n)
-in flux and in the mass-spring model; mu0 from the scene's material.mass (or density), or for a
-preset read back from the run summary's gravitational energy (--summary).
+From the frames of OUT.h5 (docs/output.md; the `velocity` and `energy_density` fields): the
+kinetic energy from the stored velocities, its peak and its last value over the peak; the same
+from the frames' own motion (|r_f - r_f-1| / dt between frames), which a velocity that says more
+than the nodes moved cannot match, and which a swing faster than the frames also reads low (the
+napkin's crease swung at 7 kHz through micrometres, docs/contact.md "Self-contact": a run
+continued from a checkpoint with --set time.output_dt=<its step> tells the two apart); the
+largest node move over the last frame; and the total energy, kinetic + gravitational (-sum m
+g.r) + elastic (energy_density times the rest dual area), with the frames where it rose. Loads,
+moving solids and free bodies do work this total does not count. The node masses are the
+discretisation's (docs/model.md, "Energy quadrature"): mu0 h1 h2 times the node's share of the
+dual area (1 inside, 1/2 on a border, 1/4 at a corner) in the default energy form, mu0 h1 h2 at
+every node in energy-nodal, M / (m n) in flux and in the mass-spring model; mu0 from the scene's
+material.mass (or density), or for a preset read back from the run summary's gravitational
+energy (--summary).
 --table prints about 25 frames. --from T counts the rises only from time T on (after moving fixes,
 loads or solids have stopped doing work).
 """
@@ -105,8 +105,9 @@ def main():
     print(f"  at the end: largest stored speed {np.linalg.norm(v[-1], axis=-1).max():.3g} m/s, "
           f"largest move over the last frame {move[-1]:.3g} m ({speed_end:.3g} m/s)")
     since = f" after t = {args.start:.4g} s" if args.start > 0.0 else ""
+    when = f" (t = {t[1 + rise.argmax()]:.3g} s)" if counted.any() else ""
     print(f"  total energy rose in {int(risen.sum())} of {int(counted.sum())} frames{since}, at "
-          f"most {rise.max():.3g} J" + (f" (t = {t[1 + rise.argmax()]:.3g} s)" if counted.any() else ""))
+          f"most {rise.max():.3g} J{when}")
     if args.table:
         for i in range(0, frames, max(1, frames // 25)):
             print(f"  t = {t[i]:8.3f}  kinetic {kinetic[i]:.3e}  from motion "
