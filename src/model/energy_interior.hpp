@@ -35,8 +35,9 @@ using ScalarOf = decltype(dot(std::declval<V>(), std::declval<V>()));
 template <class V>
 struct BasicUnit {
   V unit;
-  ScalarOf<V> inverse;  // 1/g
-  ScalarOf<V> rho;      // g g′(|c|)/|c|: 1 where c is not crushed
+  ScalarOf<V> inverse;    // 1/g
+  ScalarOf<V> rho;        // g g′(|c|)/|c|: 1 where c is not crushed
+  ScalarOf<V> shortfall;  // 1 − |u|² = 1 − y/(g/δ)²: 0 where c is not crushed
 };
 using Unit = BasicUnit<Vec3>;
 
@@ -54,11 +55,12 @@ template <bool Bounded, class V>
   if constexpr (!Bounded) {
     crushed |= below ? 1 : 0;
     const S inverse = 1.0 / sqrt(length2);
-    return {c * inverse, inverse, S(1.0)};
+    return {c * inverse, inverse, S(1.0), S(0.0)};
   }
   const S blend = 0.375 + y * (0.75 - 0.125 * y);
   const S inverse = 1.0 / (below ? crush.delta * blend : sqrt(length2));
-  return {c * inverse, inverse, below ? 0.5 * blend * (3.0 - y) : S(1.0)};
+  return {c * inverse, inverse, below ? 0.5 * blend * (3.0 - y) : S(1.0),
+          below ? 1.0 - y / (blend * blend) : S(0.0)};
 }
 
 template <class V>
@@ -101,6 +103,24 @@ template <class V>
   const V G_c = unit_gradient(q, G_s);
   // G_c · (δE × F) = δE · (F × G_c), G_c · (E × δF) = δF · (G_c × E).
   return {cross(F, G_c), cross(G_c, E)};
+}
+
+// The bending a node's crushed normal loses (docs/equations.md, "Creases folded flat"): where
+// the sum s of its corner units is crushed, n = s/g(|s|) falls short of a unit by the shortfall
+// λ = 1 − |n|², and ½ μ λ |Δ|² joins each ½ μ β² = ½ μ (n · Δ)², so that a crease folded flat,
+// whose corner units cancel, keeps the bending ½ μ |Δ|² of its second difference rather than
+// losing it as it closes. Adds its ∂/∂Δ_i = μ_i λ Δ_i and ∂/∂n = −Σ μ_i |Δ_i|² n, the latter
+// only where λ is not zero: there |n| = 1 and λ does not vary, though the rounding of n would
+// make the term a few ulps, which would change the bits of a sheet with nothing folded flat.
+template <class S, class V>
+[[gnu::always_inline]] inline void add_lost_bending(const InteriorCoefficients& c, const S& lost,
+                                                    const V& n, const V& d11, const V& d22,
+                                                    V& G_X11, V& G_X22, V& G_n) {
+  const S m11 = c.mu_beta[0] * lost, m22 = c.mu_beta[2] * lost;
+  G_X11 += m11 * d11;
+  G_X22 += m22 * d22;
+  const S squares = c.mu_beta[0] * dot(d11, d11) + c.mu_beta[2] * dot(d22, d22);
+  G_n -= (lost > 0.0 ? squares : S(0.0)) * n;
 }
 
 // Positions of p = (k, l), its neighbours and (k+1, l+1); the unit normal n of p comes back in
@@ -148,13 +168,15 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded>
         mu22 += c.mu_eps[2] * eps22;
       }
       // β_i = n · Δ_i: ∂/∂Δ_i = μ_i n, ∂/∂n = Σ μ_i Δ_i.
-      const Vec3 G_X11 = mu11 * n, G_X12 = mu12 * n, G_X22 = mu22 * n;
+      Vec3 G_X11 = mu11 * n, G_X22 = mu22 * n;
+      const Vec3 G_X12 = mu12 * n;
+      Vec3 G_n = (mu11 * d11 + mu22 * d22) + mu12 * d12;
+      if constexpr (Bounded) add_lost_bending(c, sum.shortfall, n, d11, d22, G_X11, G_X22, G_n);
       g_right = G_X11 - G_X12;
       g_left = G_X11;
       g_up = G_X22 - G_X12;
       g_down = G_X22;
       g_up_right = G_X12;
-      const Vec3 G_n = (mu11 * d11 + mu22 * d22) + mu12 * d12;
 
       // Back through n = s/g(|s|), then through each corner's unit normal.
       const Vec3 G_s = unit_gradient(sum, G_n);
@@ -229,12 +251,13 @@ template <bool Bending, bool Coupling, bool Normal, bool Bounded, class V>
         nu11 += nu11_b;
         nu22 += nu22_b;
       }
-      const V G_X11 = mu11 * n, G_X22 = mu22 * n;
+      V G_X11 = mu11 * n, G_X22 = mu22 * n;
+      V G_n = mu11 * d11 + mu22 * d22;
+      if constexpr (Bounded) add_lost_bending(c, sum.shortfall, n, d11, d22, G_X11, G_X22, G_n);
       g_right = G_X11;
       g_left = G_X11 + nu11_b * left;
       g_up = G_X22;
       g_down = G_X22 + nu22_b * down;
-      const V G_n = mu11 * d11 + mu22 * d22;
       const V G_s = unit_gradient(sum, G_n);
       const BasicCornerGradient<V> g0 = corner_gradient(q0, right, up, G_s),
                                    g1 = corner_gradient(q1, up, left, G_s),
