@@ -231,23 +231,26 @@ auto CosseratEnergy::trapezoidal_terms(const At& at, int k, int l, std::array<V,
     const V n = corners.n;
     const S kappa = -dot(n, d) / (h * h), eps = 0.5 * (eps_f + eps_b);
     part.node += w * area * (Psi[i] * kappa * kappa + Theta[i] * eps * kappa);
-    // What the crushed normal of a crease folded flat loses, λ |d|²/h⁴ with λ = 1 − |n|²
-    // (docs/equations.md, "Creases folded flat"; energy::add_lost_bending): 0 elsewhere.
+    // What the crushed normal of a crease folded flat loses, w a Ψ λ |d|²/h⁴ with λ = 1 − |n|²
+    // (docs/equations.md, "Creases folded flat"; energy::add_lost_bending): λ is 0 elsewhere.
     const S lost = corners.sum.shortfall;
     const S squares = dot(d, d) / (h * h * h * h);
-    part.node += w * area * Psi[i] * (lost * squares);
+    if (lost > 0.0) part.node += w * area * Psi[i] * (lost * squares);
     if (G == nullptr) return;
     const S M = w * area * (2.0 * Psi[i] * kappa + Theta[i] * eps);  // ∂E_p/∂κ
     N_f += 0.5 * w * area * Theta[i] * kappa;
     N_b += 0.5 * w * area * Theta[i] * kappa;
     // κ = −n · d/h²: ∂/∂d = −(M/h²) n, ∂/∂n = −(M/h²) d; d = r(p + e) + r(p − e) − 2 r. The
-    // lost bending adds 2 w a Ψ λ d/h⁴ and, where λ is not zero, −2 w a Ψ |d|²/h⁴ n.
-    const V G_d = (-M / (h * h)) * n + ((2.0 * w * area * Psi[i] / (h * h * h * h)) * lost) * d;
+    // lost bending adds 2 w a Ψ λ d/h⁴ to the first and −2 w a Ψ |d|²/h⁴ n to the second.
+    V G_d = (-M / (h * h)) * n;
+    G_n += (-M / (h * h)) * d;
+    if (lost > 0.0) {
+      G_d += ((2.0 * w * area * Psi[i] / (h * h * h * h)) * lost) * d;
+      G_n -= (2.0 * w * area * Psi[i] * squares) * n;
+    }
     add(dk, dl, G_d);
     add(-dk, -dl, G_d);
     add(0, 0, -2.0 * G_d);
-    G_n += (-M / (h * h)) * d;
-    if (lost > 0.0) G_n -= (2.0 * w * area * Psi[i] * squares) * n;
   };
   bending(bend11, right + left, h1, wl, 0, eps11_f, eps11_b, N11_f, N11_b, 1, 0);
   bending(bend22, up + down, h2, wk, 2, eps22_f, eps22_b, N22_f, N22_b, 0, 1);
@@ -439,12 +442,12 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   // What the crushed normal of a crease folded flat loses, λ |r_,αα|² with λ = 1 − |n|²
   // (docs/equations.md, "Creases folded flat"): 0 elsewhere.
   const double lost = corners.sum.shortfall;
-  const double lost11 = has.bend11 ? dot(X.r11, X.r11) : 0.0;
-  const double lost22 = has.bend22 ? dot(X.r22, X.r22) : 0.0;
+  const double square11 = has.bend11 ? dot(X.r11, X.r11) : 0.0;
+  const double square22 = has.bend22 ? dot(X.r22, X.r22) : 0.0;
   double energy = Phi[0] * epsilon[0] * epsilon[0] + Phi[2] * epsilon[2] * epsilon[2];
   if (has.bend11) energy += Psi[0] * k11 * k11 + Theta[0] * epsilon[0] * k11;
   if (has.bend22) energy += Psi[2] * k22 * k22 + Theta[2] * epsilon[2] * k22;
-  energy += lost * (Psi[0] * lost11 + Psi[2] * lost22);
+  energy += lost * (Psi[0] * square11 + Psi[2] * square22);
   if (has.shear)
     energy += 2.0 * (Phi[1] * epsilon[1] * epsilon[1] + Psi[1] * kappa[1] * kappa[1] +
                      Theta[1] * epsilon[1] * kappa[1]);
@@ -466,7 +469,7 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   // κ_αβ = −n · r_,αβ: ∂/∂r_,αβ = −M n, ∂/∂n = −Σ M r_,αβ. The lost bending adds
   // 2 a Ψ λ r_,αα and, where λ is not zero, −2 a Ψ |r_,αα|² n.
   Vec3 G_n;
-  if (lost > 0.0) G_n -= (2.0 * area * (Psi[0] * lost11 + Psi[2] * lost22)) * n;
+  if (lost > 0.0) G_n -= (2.0 * area * (Psi[0] * square11 + Psi[2] * square22)) * n;
   if (has.bend11) {
     const Vec3 G_X = (-M11 / (h1 * h1)) * n + ((2.0 * area * Psi[0] * lost / (h1 * h1)) * X.r11);
     G[slot(1, 0)] += G_X;
