@@ -590,9 +590,10 @@ int main(int argc, char** argv) {
   CLI::App* run_command = app.add_subcommand("run", "Run a scene and write its frames to HDF5 + XDMF");
   run_command->add_option("scene", options.scene_path, "Scene file (TOML, see docs/scene-format.md)")
       ->required();
-  run_command->add_option("--set", options.overrides,
-                          "Override a scene key: dotted.key=value, the value read as TOML "
-                          "(e.g. --set time.dt=5e-4 --set grid.nodes=[64,64]); repeatable")
+  run_command
+      ->add_option("--set", options.overrides,
+                   "Override a scene key: dotted.key=value, the value read as TOML "
+                   "(e.g. --set time.dt=5e-4 --set solid[0].friction=0); repeatable")
       ->allow_extra_args(false);
   run_command->add_option("-o,--output", options.output,
                           "HDF5 output file (default: <scene file stem>.h5 in the working "

@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include <optional>
+#include <string>
 #include <string_view>
 #include <utility>
 #include <vector>
@@ -29,19 +31,65 @@ std::string_view trim(std::string_view text) {
   throw SceneError(fmt::format("{}: --set '{}': {}", origin.path(), assignment, what));
 }
 
-std::vector<std::string> dotted_components(const Origin& origin, const std::string& assignment,
-                                           std::string_view key) {
-  std::vector<std::string> components;
+// One component of a dotted key: a key, or `key[i]`, element i of the array there.
+struct Component {
+  std::string key;
+  std::optional<std::size_t> index;
+  std::string text;  // as given, for messages
+};
+
+Component component_of(const Origin& origin, const std::string& assignment, std::string_view text) {
+  Component component{std::string(text), std::nullopt, std::string(text)};
+  const auto open = text.find('[');
+  if (open == std::string_view::npos) return component;
+  const auto digits = text.substr(open + 1, text.size() - open - 2);
+  if (open == 0 || text.back() != ']' || digits.empty() ||
+      digits.find_first_not_of("0123456789") != std::string_view::npos || digits.size() > 9) {
+    bad_override(origin, assignment,
+                 fmt::format("'{}' is not a key or key[index] with a whole number", text));
+  }
+  component.key = std::string(trim(text.substr(0, open)));
+  component.index = std::stoul(std::string(digits));
+  return component;
+}
+
+std::vector<Component> dotted_components(const Origin& origin, const std::string& assignment,
+                                         std::string_view key) {
+  std::vector<Component> components;
   std::size_t begin = 0;
   while (true) {
     const auto dot = key.find('.', begin);
     const auto component =
         trim(key.substr(begin, dot == std::string_view::npos ? dot : dot - begin));
     if (component.empty()) bad_override(origin, assignment, "empty key; expected dotted.key=value");
-    components.emplace_back(component);
+    components.push_back(component_of(origin, assignment, component));
     if (dot == std::string_view::npos) return components;
     begin = dot + 1;
   }
+}
+
+// The array at `component.key` in `table`, which must be there with element `component.index`:
+// an override changes a [[block]] of the file (`solid[0].friction=0`, as messages name its
+// keys) but adds or removes none, so what is simulated stays what the file lists.
+toml::array& array_with_element(toml::table& table, const Component& component,
+                                const std::string& prefix, const Origin& origin,
+                                const std::string& assignment) {
+  toml::node* node = table.get(component.key);
+  toml::array* array = node == nullptr ? nullptr : node->as_array();
+  if (array == nullptr) {
+    bad_override(origin, assignment,
+                 node == nullptr
+                     ? fmt::format("'{}' names an element of '{}', which the scene does not have",
+                                   prefix, component.key)
+                     : fmt::format("'{}' names an element of '{}', which is {}, not an array",
+                                   prefix, component.key, describe(*node)));
+  }
+  if (*component.index >= array->size()) {
+    bad_override(origin, assignment,
+                 fmt::format("'{}' is past the end: '{}' has {} element{}", prefix, component.key,
+                             array->size(), array->size() == 1 ? "" : "s"));
+  }
+  return *array;
 }
 
 // The value as TOML, or else as the bare text, so `time.integrator=rk4` needs no quotes. Text
@@ -74,9 +122,13 @@ void apply_override(toml::table& document, const std::string& assignment, const 
   toml::table* table = &document;
   std::string prefix;
   for (std::size_t i = 0; i + 1 < components.size(); ++i) {
-    prefix += (i == 0 ? "" : ".") + components[i];
-    toml::node* node = table->get(components[i]);
-    if (node == nullptr) node = &table->insert(components[i], toml::table{}).first->second;
+    const Component& component = components[i];
+    prefix += (i == 0 ? "" : ".") + component.text;
+    toml::node* node = component.index
+                           ? array_with_element(*table, component, prefix, origin, assignment)
+                                 .get(*component.index)
+                           : table->get(component.key);
+    if (node == nullptr) node = &table->insert(component.key, toml::table{}).first->second;
     table = node->as_table();
     if (table == nullptr) {
       bad_override(origin, assignment,
@@ -85,7 +137,15 @@ void apply_override(toml::table& document, const std::string& assignment, const 
   }
   auto value =
       override_value(origin, assignment, trim(std::string_view(assignment).substr(equals + 1)));
-  table->insert_or_assign(components.back(), std::move(*value.get("value")));
+  const Component& last = components.back();
+  if (last.index) {
+    prefix += (components.size() == 1 ? "" : ".") + last.text;
+    auto& array = array_with_element(*table, last, prefix, origin, assignment);
+    array.replace(array.cbegin() + static_cast<std::ptrdiff_t>(*last.index),
+                  std::move(*value.get("value")));
+    return;
+  }
+  table->insert_or_assign(last.key, std::move(*value.get("value")));
 }
 
 }  // namespace cosserat::scene_detail

@@ -630,6 +630,40 @@ TEST(SceneSet, OutputFields) {
                     HasSubstr("unknown field \"strain\"")));
 }
 
+// Messages name a block's keys `solid[i].key`; --set takes them so, and changes that block of
+// the file only.
+TEST(SceneSet, IndexedKeysChangeOneBlockOfTheFile) {
+  SceneText text;
+  text.tail =
+      "[[solid]]\nshape = \"sphere\"\ncenter = [5.0, -1.0, 2.5]\nradius = 0.5\n"
+      "[[solid]]\nshape = \"plane\"\npoint = [0.0, -3.0, 0.0]\nnormal = [0.0, 1.0, 0.0]\n";
+  const Scene scene = parse(text, {"solid[1].friction=0.25", "grid.nodes[0]=8"});
+  ASSERT_EQ(scene.solids.size(), 2u);
+  EXPECT_EQ(scene.solids[0].friction, SolidSpec{}.friction);
+  EXPECT_EQ(scene.solids[1].friction, 0.25);
+  EXPECT_EQ(scene.m, 8);
+  EXPECT_EQ(scene.n, 12);
+  EXPECT_THAT(error_of(text, {"solid[1].frictio=1"}),
+              AllOf(HasSubstr("(from --set): key 'solid[1].frictio'"), HasSubstr("unknown key")));
+}
+
+TEST(SceneSet, IndexesAddNoBlockAndMustBeWholeNumbers) {
+  SceneText text;
+  text.tail = "[[solid]]\nshape = \"sphere\"\ncenter = [5.0, -1.0, 2.5]\nradius = 0.5\n";
+  EXPECT_THAT(error_of(text, {"solid[1].friction=0"}),
+              AllOf(HasSubstr("--set 'solid[1].friction=0'"),
+                    HasSubstr("'solid[1]' is past the end: 'solid' has 1 element")));
+  EXPECT_THAT(error_of(text, {"fix[0].nodes=[[0, 0]]"}),
+              HasSubstr("'fix[0]' names an element of 'fix', which the scene does not have"));
+  EXPECT_THAT(error_of(text, {"time[0].dt=1"}),
+              HasSubstr("'time[0]' names an element of 'time', which is a table, not an array"));
+  for (const std::string key : {"solid[a]", "solid[-1]", "solid[]", "[0]", "solid[0"}) {
+    EXPECT_THAT(error_of(text, {key + ".friction=0"}),
+                HasSubstr("is not a key or key[index] with a whole number"))
+        << key;
+  }
+}
+
 TEST(SceneSet, WithoutEqualsIsRejected) {
   EXPECT_THAT(error_of(SceneText{}, {"time.dt"}),
               AllOf(HasSubstr("--set 'time.dt'"), HasSubstr("dotted.key=value")));
