@@ -234,8 +234,11 @@ auto CosseratEnergy::trapezoidal_terms(const At& at, int k, int l, std::array<V,
     // What the crushed normal of a crease folded flat loses, w a Ψ λ |d|²/h⁴ with λ = 1 − |n|²
     // (docs/equations.md, "Creases folded flat"; energy::add_lost_bending): λ is 0 elsewhere.
     const S lost = corners.sum.shortfall;
-    const S squares = dot(d, d) / (h * h * h * h);
-    if (lost > 0.0) part.node += w * area * Psi[i] * (lost * squares);
+    S squares(0.0);
+    if (lost > 0.0) {
+      squares = dot(d, d) / (h * h * h * h);
+      part.node += w * area * Psi[i] * (lost * squares);
+    }
     if (G == nullptr) return;
     const S M = w * area * (2.0 * Psi[i] * kappa + Theta[i] * eps);  // ∂E_p/∂κ
     N_f += 0.5 * w * area * Theta[i] * kappa;
@@ -442,12 +445,15 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   // What the crushed normal of a crease folded flat loses, λ |r_,αα|² with λ = 1 − |n|²
   // (docs/equations.md, "Creases folded flat"): 0 elsewhere.
   const double lost = corners.sum.shortfall;
-  const double square11 = has.bend11 ? dot(X.r11, X.r11) : 0.0;
-  const double square22 = has.bend22 ? dot(X.r22, X.r22) : 0.0;
+  double square11 = 0.0, square22 = 0.0;
+  if (lost > 0.0) {
+    if (has.bend11) square11 = dot(X.r11, X.r11);
+    if (has.bend22) square22 = dot(X.r22, X.r22);
+  }
   double energy = Phi[0] * epsilon[0] * epsilon[0] + Phi[2] * epsilon[2] * epsilon[2];
   if (has.bend11) energy += Psi[0] * k11 * k11 + Theta[0] * epsilon[0] * k11;
   if (has.bend22) energy += Psi[2] * k22 * k22 + Theta[2] * epsilon[2] * k22;
-  energy += lost * (Psi[0] * square11 + Psi[2] * square22);
+  if (lost > 0.0) energy += lost * (Psi[0] * square11 + Psi[2] * square22);
   if (has.shear)
     energy += 2.0 * (Phi[1] * epsilon[1] * epsilon[1] + Psi[1] * kappa[1] * kappa[1] +
                      Theta[1] * epsilon[1] * kappa[1]);
@@ -471,14 +477,16 @@ double CosseratEnergy::nodal_energy(const Field<Vec3>& R, int k, int l, StencilG
   Vec3 G_n;
   if (lost > 0.0) G_n -= (2.0 * area * (Psi[0] * square11 + Psi[2] * square22)) * n;
   if (has.bend11) {
-    const Vec3 G_X = (-M11 / (h1 * h1)) * n + ((2.0 * area * Psi[0] * lost / (h1 * h1)) * X.r11);
+    Vec3 G_X = (-M11 / (h1 * h1)) * n;
+    if (lost > 0.0) G_X += (2.0 * area * Psi[0] * lost / (h1 * h1)) * X.r11;
     G[slot(1, 0)] += G_X;
     G[slot(-1, 0)] += G_X;
     G[slot(0, 0)] -= 2.0 * G_X;
     G_n -= M11 * X.r11;
   }
   if (has.bend22) {
-    const Vec3 G_X = (-M22 / (h2 * h2)) * n + ((2.0 * area * Psi[2] * lost / (h2 * h2)) * X.r22);
+    Vec3 G_X = (-M22 / (h2 * h2)) * n;
+    if (lost > 0.0) G_X += (2.0 * area * Psi[2] * lost / (h2 * h2)) * X.r22;
     G[slot(0, 1)] += G_X;
     G[slot(0, -1)] += G_X;
     G[slot(0, 0)] -= 2.0 * G_X;
