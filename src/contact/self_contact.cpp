@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 
@@ -665,21 +666,26 @@ void SelfContact::find_pairs() {
     for (std::size_t e = 0; e < listed_.size(); ++e) cell_box(static_cast<std::size_t>(listed_[e]));
   }
   planes_.resize(4 * box_lo_.size());
-#pragma omp parallel for schedule(static)
-  for (std::size_t e = 0; e < listed_.size(); ++e)
-    cell_planes(static_cast<std::size_t>(listed_[e]));
+  needed_.resize(box_lo_.size(), 0);
 
+  // First the boxes: each node's hits, the cells of its list whose box meets its own, in list
+  // order; then the planes of the cells some node hit (in S6 with its loads x 5, three in five
+  // of the cells listed); then the hits' triangles, node by node. Each thread walks the same
+  // nodes in both loops (the same static schedule over the same range).
   const double t = thickness_;
-  thread_pairs_.resize(static_cast<std::size_t>(omp_get_max_threads()));
+  const auto threads = static_cast<std::size_t>(omp_get_max_threads());
+  thread_pairs_.resize(threads);
+  thread_hits_.resize(threads);
   for (std::vector<Pair>& found : thread_pairs_) found.clear();
+  for (std::vector<Hit>& hits : thread_hits_) hits.clear();
 #pragma omp parallel
   {
-    std::vector<Pair>& found = thread_pairs_[static_cast<std::size_t>(omp_get_thread_num())];
+    const auto me = static_cast<std::size_t>(omp_get_thread_num());
+    std::vector<Hit>& hits = thread_hits_[me];
 #pragma omp for schedule(static)
     for (std::size_t at = 0; at < present_nodes_.size(); ++at) {
       const auto p = static_cast<std::size_t>(present_nodes_[at]);
       if (list_start_[p] == list_start_[p + 1]) continue;
-      const std::size_t first = found.size();
       Vec3 lo = start_[p], hi = lo;
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::min(lo[a], end_[p][a]) - t;
@@ -690,67 +696,82 @@ void SelfContact::find_pairs() {
         bool apart = false;
         for (int a = 0; a < 3; ++a) apart = apart || box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a];
         if (apart) continue;
-        const Triangles triangles = cell_triangles(c);
-        for (int j = 0; j < 4; ++j) {
-          const auto& tri = triangles[j];
-          const Plane& plane =
-              planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
-          // A triangle that turned over in the step (a cell collapsing through itself) has no
-          // side to keep: every node near it would seem to have crossed it, by as much as the
-          // triangle's size, and be thrown that far.
-          if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0) ||
-              !(dot(plane.normal0, plane.normal1) > 0.0))
-            continue;
-          const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
-          const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
-          const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
-          const double side = d0 >= 0.0 ? 1.0 : -1.0;
-          const Vec3& normal = plane.normal1;
-          const double area1 = plane.area1;
-          const double d1 = dot(normal, end_[p] - a1);
-          if (side * d1 >= t) continue;
-          // Crossed over the step: where the node met the plane (linearly between the two
-          // distances) must lie in the triangle, or within the thickness of its edges, or it
-          // passed beside it; it goes back to its side along the triangle's normal. Still on
-          // its side: a foot in the triangle holds it along the normal; a foot beside it (a
-          // node at the cloth's border, which has no triangle beyond the edge) is held the
-          // thickness from the triangle's nearest point, along the line from that point:
-          // beyond the triangle the plane's distance is not the triangle's.
-          const double slack = t / std::sqrt(area1);
-          const Foot at_end = foot(end_[p], a1, b1, c1);
-          Foot on = at_end;
-          double pair_side = side;
-          Vec3 direction = normal;
-          bool beside = false;
-          if (side * d1 < 0.0) {
-            const double s = d0 / (d0 - d1);
-            const Foot crossing = foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s),
-                                       lerp(b0, b1, s), lerp(c0, c1, s));
-            if (!crossing.near(slack) || !at_end.near(1.0)) continue;
-            on = at_end.clamped();
-          } else if (!at_end.near(0.0)) {
-            if (!at_end.near(slack)) continue;
-            on = at_end.clamped();
-            beside = true;
-            const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
-            const double distance = norm(away);
-            if (distance >= t) continue;
-            if (distance > 0.0) {
-              direction = away / distance;
-              pair_side = 1.0;
-            }
-          }
-          found.push_back(Pair{{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2]},
-                               {1.0, -on.a, -on.b, -on.c},
-                               pair_side,
-                               0.5,
-                               direction,
-                               beside});
-        }
+        hits.push_back({static_cast<std::int32_t>(p), c});
+        std::atomic_ref<char>(needed_[static_cast<std::size_t>(c)])
+            .store(1, std::memory_order_relaxed);
       }
-      drop_covered(found, first);
+    }
+#pragma omp for schedule(static)
+    for (std::size_t e = 0; e < listed_.size(); ++e) {
+      const auto c = static_cast<std::size_t>(listed_[e]);
+      if (needed_[c] != 0) cell_planes(c);
+    }
+    std::vector<Pair>& found = thread_pairs_[me];
+    std::size_t first = 0;
+    for (std::size_t h = 0; h < hits.size(); ++h) {
+      const auto p = static_cast<std::size_t>(hits[h].node);
+      const std::int32_t c = hits[h].cell;
+      if (h == 0 || hits[h - 1].node != hits[h].node) first = found.size();
+      const Triangles triangles = cell_triangles(c);
+      for (int j = 0; j < 4; ++j) {
+        const auto& tri = triangles[j];
+        const Plane& plane = planes_[4 * static_cast<std::size_t>(c) + static_cast<std::size_t>(j)];
+        // A triangle that turned over in the step (a cell collapsing through itself) has no
+        // side to keep: every node near it would seem to have crossed it, by as much as the
+        // triangle's size, and be thrown that far.
+        if (!(plane.area0 > 0.0) || !(plane.area1 > 0.0) ||
+            !(dot(plane.normal0, plane.normal1) > 0.0))
+          continue;
+        const Vec3 &a0 = start_[tri[0]], &b0 = start_[tri[1]], &c0 = start_[tri[2]];
+        const Vec3 &a1 = end_[tri[0]], &b1 = end_[tri[1]], &c1 = end_[tri[2]];
+        const double d0 = dot(plane.normal0, start_[p] - a0) / plane.area0;
+        const double side = d0 >= 0.0 ? 1.0 : -1.0;
+        const Vec3& normal = plane.normal1;
+        const double area1 = plane.area1;
+        const double d1 = dot(normal, end_[p] - a1);
+        if (side * d1 >= t) continue;
+        // Crossed over the step: where the node met the plane (linearly between the two
+        // distances) must lie in the triangle, or within the thickness of its edges, or it
+        // passed beside it; it goes back to its side along the triangle's normal. Still on
+        // its side: a foot in the triangle holds it along the normal; a foot beside it (a
+        // node at the cloth's border, which has no triangle beyond the edge) is held the
+        // thickness from the triangle's nearest point, along the line from that point:
+        // beyond the triangle the plane's distance is not the triangle's.
+        const double slack = t / std::sqrt(area1);
+        const Foot at_end = foot(end_[p], a1, b1, c1);
+        Foot on = at_end;
+        double pair_side = side;
+        Vec3 direction = normal;
+        bool beside = false;
+        if (side * d1 < 0.0) {
+          const double s = d0 / (d0 - d1);
+          const Foot crossing =
+              foot(lerp(start_[p], end_[p], s), lerp(a0, a1, s), lerp(b0, b1, s), lerp(c0, c1, s));
+          if (!crossing.near(slack) || !at_end.near(1.0)) continue;
+          on = at_end.clamped();
+        } else if (!at_end.near(0.0)) {
+          if (!at_end.near(slack)) continue;
+          on = at_end.clamped();
+          beside = true;
+          const Vec3 away = end_[p] - (on.a * a1 + on.b * b1 + on.c * c1);
+          const double distance = norm(away);
+          if (distance >= t) continue;
+          if (distance > 0.0) {
+            direction = away / distance;
+            pair_side = 1.0;
+          }
+        }
+        found.push_back(Pair{{static_cast<std::int32_t>(p), tri[0], tri[1], tri[2]},
+                             {1.0, -on.a, -on.b, -on.c},
+                             pair_side,
+                             0.5,
+                             direction,
+                             beside});
+      }
+      if (h + 1 == hits.size() || hits[h + 1].node != hits[h].node) drop_covered(found, first);
     }
   }
+  for (const std::int32_t c : listed_) needed_[static_cast<std::size_t>(c)] = 0;
   pairs_.clear();
   for (const std::vector<Pair>& found : thread_pairs_)
     pairs_.insert(pairs_.end(), found.begin(), found.end());
@@ -884,8 +905,11 @@ double SelfContact::inverse_mass(const Pair& q, const std::vector<double>& inver
 // `sign` × `direction` to each of its nodes' `sums`, by weight and `inverse` mass, with the
 // pair's share and relaxation. The weights sum to zero, so a pair's moves and impulses keep the
 // momentum of its nodes (a node that does not move takes what the others give).
-void SelfContact::share_out(const Pair& q, double amount, double sign, const Vec3& direction,
-                            const std::vector<double>& inverse, std::vector<Vec3>& sums) {
+// Inlined: called for every pair in every pass, its call cost as much as its work.
+[[gnu::always_inline]] inline void SelfContact::share_out(const Pair& q, double amount, double sign,
+                                                          const Vec3& direction,
+                                                          const std::vector<double>& inverse,
+                                                          std::vector<Vec3>& sums) {
   const double scale = q.share * q.relaxation * amount * sign;
   for (int i = 0; i < 4; ++i) {
     const auto node = static_cast<std::size_t>(q.nodes[i]);

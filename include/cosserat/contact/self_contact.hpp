@@ -150,6 +150,11 @@ class SelfContact {
     double area1;
   };
   std::vector<Plane> planes_;  // four a cell, in the order of find_pairs' triangles; listed only
+  std::vector<char> needed_;   // a listed cell some node's box meets this step (find_pairs)
+  struct Hit {
+    std::int32_t node, cell;
+  };
+  std::vector<std::vector<Hit>> thread_hits_;  // each thread's, in its nodes' order
 
   // The broad phase: every cell's box over the step in buckets of a spatial hash.
   std::vector<Vec3> box_lo_, box_hi_;
