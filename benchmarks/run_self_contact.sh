@@ -26,6 +26,20 @@ print(f\"{d['node_steps_per_second']:.3e} {(d['self_contact'] or {}).get('max_pa
     "$work/run.json"
 }
 
+row() {  # label threads steps off-scene on-scene [args...]: a table row, self-contact off and on
+  # (the flags of "on" added where both runs are of one scene)
+  local label=$1 threads=$2 steps=$3 off_scene=$4 on_scene=$5 off with pairs ratio
+  shift 5
+  read -r off _ < <(rate "$threads" "$off_scene" "$@")
+  if [[ $on_scene == "$off_scene" ]]; then
+    read -r with pairs < <(rate "$threads" "$on_scene" "$@" "${on[@]}")
+  else
+    read -r with pairs < <(rate "$threads" "$on_scene" "$@")
+  fi
+  ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
+  echo "| $label | $threads | $steps | $off | $with | $ratio | $pairs |"
+}
+
 best() {  # repeats threads steps [args...]: the least wall time of the 1024² sheet's runs
   local repeats=$1 threads=$2 steps=$3
   shift 3
@@ -52,10 +66,7 @@ best() {  # repeats threads steps [args...]: the least wall time of the 1024² s
     steps=${spec##*:}
     jobs/make_large_sheet.sh "$nodes" "$steps" "$work/sheet.toml"
     for threads in 1 2; do
-      read -r off _ < <(rate "$threads" "$work/sheet.toml")
-      read -r with pairs < <(rate "$threads" "$work/sheet.toml" "${on[@]}")
-      ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
-      echo "| hanging sheet ${nodes}² | $threads | $steps | $off | $with | $ratio | $pairs |"
+      row "hanging sheet ${nodes}²" "$threads" "$steps" "$work/sheet.toml" "$work/sheet.toml"
     done
   done
   echo
@@ -76,10 +87,8 @@ print(f'| $threads | {1e3 * off:.1f} | {1e3 * on:.1f} | {on / off - 1:+.0%} | {b
   echo
   echo "| scene | threads | steps | off (node-steps/s) | on | on / off | most pairs in a step |"
   echo "|---|---|---|---|---|---|---|"
-  read -r off _ < <(rate 1 scenes/hard/s6_loads_x5.toml)
-  read -r with pairs < <(rate 1 scenes/hard/s6_loads_x5.toml "${on[@]}")
-  ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
-  echo "| s6_loads_x5 (60², 20 000 steps) | 1 | 20000 | $off | $with | $ratio | $pairs |"
+  row "s6_loads_x5 (60², 20 000 steps)" 1 20000 scenes/hard/s6_loads_x5.toml \
+    scenes/hard/s6_loads_x5.toml
   # S6 x 5 at 240² (issue 31): each load of a node [k, l] of the 60² grid spread over the 4 x 4
   # nodes around [4k, 4l], at the same force per area (100 h1 h2 and 25 h1 h2 a component on
   # each; on the one node [4k, 4l] the sheet hardly folds), its first 6 s in adaptive steps
@@ -103,14 +112,9 @@ text = re.sub(r"^output_every = .*$", "output_dt = 0.06", text, flags=re.M)
 open(sys.argv[2], "w").write(text)
 PY
   for threads in 1 2; do
-    read -r off _ < <(rate "$threads" "$work/s6_240.toml")
-    read -r with pairs < <(rate "$threads" "$work/s6_240.toml" "${on[@]}")
-    ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
-    echo "| S6 x 5 at 240² (6 s, adaptive steps) | $threads | — | $off | $with | $ratio | $pairs |"
+    row "S6 x 5 at 240² (6 s, adaptive steps)" "$threads" — "$work/s6_240.toml" "$work/s6_240.toml"
   done
   sed '/^\[self_contact\]/,/^$/d' scenes/contact/napkin_fold.toml >"$work/napkin_off.toml"
-  read -r off _ < <(rate 1 "$work/napkin_off.toml" --set time.duration=0.5)
-  read -r with pairs < <(rate 1 scenes/contact/napkin_fold.toml --set time.duration=0.5)
-  ratio=$(/usr/bin/python3 -c "print(f'{$with / $off:.3f}')")
-  echo "| napkin_fold (26 × 51, 0.5 s) | 1 | 50000 | $off | $with | $ratio | $pairs |"
+  row "napkin_fold (26 × 51, 0.5 s)" 1 50000 "$work/napkin_off.toml" \
+    scenes/contact/napkin_fold.toml --set time.duration=0.5
 } | tee "$stem.md"
