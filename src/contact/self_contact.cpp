@@ -670,8 +670,8 @@ void SelfContact::find_pairs() {
 
   // First the boxes: each node's hits, the cells of its list whose box meets its own, in list
   // order; then the planes of the cells some node hit (in S6 with its loads x 5, three in five
-  // of the cells listed); then the hits' triangles, node by node. Each thread walks the same
-  // nodes in both loops (the same static schedule over the same range).
+  // of the cells listed); then each thread tests the triangles of the hits it found, so that
+  // its pairs come in its nodes' order as before.
   const double t = thickness_;
   const auto threads = static_cast<std::size_t>(omp_get_max_threads());
   thread_pairs_.resize(threads);

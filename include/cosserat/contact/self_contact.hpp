@@ -149,7 +149,7 @@ class SelfContact {
     Vec3 normal1;
     double area1;
   };
-  std::vector<Plane> planes_;  // four a cell, in the order of find_pairs' triangles; listed only
+  std::vector<Plane> planes_;  // four a cell, in the order of find_pairs' triangles; hit only
   std::vector<char> needed_;   // a listed cell some node's box meets this step (find_pairs)
   struct Hit {
     std::int32_t node, cell;
