@@ -150,6 +150,7 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   const auto cells = static_cast<std::size_t>(block.m - 1) * static_cast<std::size_t>(block.n - 1);
   box_lo_.resize(cells);
   box_hi_.resize(cells);
+  needed_.assign(cells, 0);
   const int m = block.m, n = block.n;
   const int horizontal = (m - 1) * n;
   for (int e = 0; e < horizontal; ++e) {
@@ -666,7 +667,6 @@ void SelfContact::find_pairs() {
     for (std::size_t e = 0; e < listed_.size(); ++e) cell_box(static_cast<std::size_t>(listed_[e]));
   }
   planes_.resize(4 * box_lo_.size());
-  needed_.resize(box_lo_.size(), 0);
 
   // First the boxes: each node's hits, the cells of its list whose box meets its own, in list
   // order; then the planes of the cells some node hit (in S6 with its loads x 5, three in five
