@@ -18,6 +18,13 @@ function(cosserat_source_options root)
     PROPERTIES COMPILE_OPTIONS -fno-math-errno)
   # So do the contact's plane lanes, and only without the -frounding-math that CGAL's target
   # adds to the module: no code of this file changes the rounding mode, or calls CGAL.
+  # The lanes' selections (a ? b : c) vectorise for AVX2, which has no masked arithmetic, only
+  # where the compiler may compute both arms: without -ftrapping-math, which changes no result
+  # but lets an unselected arm raise a flag. A build that traps those flags keeps it.
+  set(contact_options -fno-math-errno -fno-rounding-math)
+  if(NOT COSSERAT_TRAP_FPE)
+    list(APPEND contact_options -fno-trapping-math)
+  endif()
   set_source_files_properties(${root}/src/contact/contact.cpp
-    PROPERTIES COMPILE_OPTIONS "-fno-math-errno;-fno-rounding-math")
+    PROPERTIES COMPILE_OPTIONS "${contact_options}")
 endfunction()

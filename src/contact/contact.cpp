@@ -481,7 +481,9 @@ Vec3 Contact::take_offset(int k, int l) {
 // planes node by node before: 20 ns a node-step with a plane under every node at 1024²
 // (benchmarks/results/contact-lanes-*). Sixteen lanes rather than eight: one plane's response
 // is a long chain of dependent operations, and eight lanes left the core waiting on it
-// (benchmarks/results/contact-starts-*).
+// (benchmarks/results/contact-starts-*). OneStill: one plane that does not turn, whose normal
+// and velocity every lane it meets shares, so the lanes do not carry them (the benchmark's
+// plane 7.5 → 5.5 ns a node-step, benchmarks/results/contact-one-plane-*).
 namespace {
 constexpr int kLanes = 16;
 // |t|² < (1 − 1e-12) s² with s > 0 gives √|t|², rounded, below s.
@@ -497,9 +499,11 @@ struct Contact::PlaneLanes {
   long met[kLanes];
 };
 
+template <bool OneStill>
 inline void Contact::meet_planes(PlaneLanes& a) const {
   for (int i = 0; i < kLanes; ++i) {
-    a.nx[i] = a.ny[i] = a.nz[i] = a.ux[i] = a.uy[i] = a.uz[i] = a.speed[i] = 0.0;
+    if constexpr (!OneStill) a.nx[i] = a.ny[i] = a.nz[i] = a.ux[i] = a.uy[i] = a.uz[i] = 0.0;
+    a.speed[i] = 0.0;
     a.met[i] = 0;
   }
   const double dt = dt_;
@@ -557,7 +561,7 @@ inline void Contact::meet_planes(PlaneLanes& a) const {
       }
       return sliding;
     };
-    const bool turning = w.x != 0.0 || w.y != 0.0 || w.z != 0.0;
+    const bool turning = !OneStill && (w.x != 0.0 || w.y != 0.0 || w.z != 0.0);
     const long sliding =
         turning ? approach.template operator()<true>() : approach.template operator()<false>();
     // Nodes lying still on a plane all stick: their lanes need no square root nor division.
@@ -591,12 +595,14 @@ inline void Contact::meet_planes(PlaneLanes& a) const {
         a.vx[i] = hit ? vx : a.vx[i];
         a.vy[i] = hit ? vy : a.vy[i];
         a.vz[i] = hit ? vz : a.vz[i];
-        a.nx[i] = hit ? n.x : a.nx[i];
-        a.ny[i] = hit ? n.y : a.ny[i];
-        a.nz[i] = hit ? n.z : a.nz[i];
-        a.ux[i] = hit ? ux[i] : a.ux[i];
-        a.uy[i] = hit ? uy[i] : a.uy[i];
-        a.uz[i] = hit ? uz[i] : a.uz[i];
+        if constexpr (!OneStill) {
+          a.nx[i] = hit ? n.x : a.nx[i];
+          a.ny[i] = hit ? n.y : a.ny[i];
+          a.nz[i] = hit ? n.z : a.nz[i];
+          a.ux[i] = hit ? ux[i] : a.ux[i];
+          a.uy[i] = hit ? uy[i] : a.uy[i];
+          a.uz[i] = hit ? uz[i] : a.uz[i];
+        }
         a.speed[i] = hit ? leaving : a.speed[i];
         a.met[i] = hit ? 1 : a.met[i];
       }
@@ -758,6 +764,17 @@ void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
 // the nodes it does not move, so the row of starts is whole. Which nodes it moved, and their
 // velocities after the planes, stay for prepare().
 void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) {
+  const Vec3 w = solids_[order_[0]].proposed.angular_velocity;
+  if (planes_ == 1 && w.x == 0.0 && w.y == 0.0 && w.z == 0.0)
+    walk_planes_of<true>(l, current, next);
+  else
+    walk_planes_of<false>(l, current, next);
+}
+
+// OneStill: one plane, which does not turn, so every lane it meets has its normal and its
+// velocity, and the lanes need not carry them.
+template <bool OneStill>
+void Contact::walk_planes_of(int l, const Field<Vec3>& current, Field<Vec3>& next) {
   const Block& b = *block_;
   const auto row = static_cast<std::size_t>(l - b.l0);
   const std::size_t first = row * static_cast<std::size_t>(b.owned_k());
@@ -774,15 +791,30 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
   const Vec3* origins = &current(b.k0, l);
   Vec3* ends = &next(b.k0, l);
   Vec3* starts = &(*walk_starts_)(b.k0, l);
+  // A row's last block, when shorter than the lanes, goes through these.
+  Vec3 tail_origins[kLanes], tail_ends[kLanes], tail_starts[kLanes];
   for (int k0 = 0; k0 < b.owned_k(); k0 += kLanes) {
     // A row's last lanes repeat its last node, and are not read.
     const int lanes = std::min(kLanes, b.owned_k() - k0);
+    const Vec3* from = origins + k0;
+    const Vec3* to = ends + k0;
+    if (lanes < kLanes) {
+      for (int i = 0; i < kLanes; ++i) {
+        const int k = k0 + std::min(i, lanes - 1);
+        tail_origins[i] = origins[k];
+        tail_ends[i] = ends[k];
+      }
+      from = tail_origins;
+      to = tail_ends;
+    }
+    // As three packed doubles, so that the loop de-interleaves them with shuffles (node by
+    // node, the compiler moved each double alone).
+    const double* o = &from->x;
+    const double* e = &to->x;
+#pragma omp simd
     for (int i = 0; i < kLanes; ++i) {
-      const int k = k0 + std::min(i, lanes - 1);
-      const Vec3 r = ends[k];
-      const Vec3 start = origins[k];
-      sx[i] = start.x, sy[i] = start.y, sz[i] = start.z;
-      a.rx[i] = r.x, a.ry[i] = r.y, a.rz[i] = r.z;
+      sx[i] = o[3 * i], sy[i] = o[3 * i + 1], sz[i] = o[3 * i + 2];
+      a.rx[i] = e[3 * i], a.ry[i] = e[3 * i + 1], a.rz[i] = e[3 * i + 2];
     }
 #pragma omp simd
     for (int i = 0; i < kLanes; ++i) {
@@ -790,7 +822,7 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
       a.vy[i] = (a.ry[i] - sy[i]) * rate;
       a.vz[i] = (a.rz[i] - sz[i]) * rate;
     }
-    meet_planes(a);
+    meet_planes<OneStill>(a);
     long any = 0;
     for (int i = 0; i < kLanes; ++i) any |= a.met[i];
     if (!any) {
@@ -801,17 +833,23 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
     // settled() of the velocity the node leaves with, operation for operation, as
     // settled_velocity() finds it on a prepared tile; then VerletFamily::set_velocities' r⁻
     // of it, the same way.
+    const Solid& still = solids_[order_[0]];
 #pragma omp simd
     for (int i = 0; i < kLanes; ++i) {
       const double mx = (a.rx[i] - sx[i]) * rate, my = (a.ry[i] - sy[i]) * rate,
                    mz = (a.rz[i] - sz[i]) * rate;
-      const double normal =
-          (mx - a.ux[i]) * a.nx[i] + (my - a.uy[i]) * a.ny[i] + (mz - a.uz[i]) * a.nz[i];
+      const double nx = OneStill ? still.plane_normal.x : a.nx[i];
+      const double ny = OneStill ? still.plane_normal.y : a.ny[i];
+      const double nz = OneStill ? still.plane_normal.z : a.nz[i];
+      const double ux = OneStill ? still.proposed.velocity.x : a.ux[i];
+      const double uy = OneStill ? still.proposed.velocity.y : a.uy[i];
+      const double uz = OneStill ? still.proposed.velocity.z : a.uz[i];
+      const double normal = (mx - ux) * nx + (my - uy) * ny + (mz - uz) * nz;
       const double lift = a.speed[i] - normal;
       const bool met = a.met[i] != 0;
-      wx[i] = met ? a.rx[i] - dt * (mx + lift * a.nx[i]) : sx[i];
-      wy[i] = met ? a.ry[i] - dt * (my + lift * a.ny[i]) : sy[i];
-      wz[i] = met ? a.rz[i] - dt * (mz + lift * a.nz[i]) : sz[i];
+      wx[i] = met ? a.rx[i] - dt * (mx + lift * nx) : sx[i];
+      wy[i] = met ? a.ry[i] - dt * (my + lift * ny) : sy[i];
+      wz[i] = met ? a.rz[i] - dt * (mz + lift * nz) : sz[i];
     }
     // any_inside()'s test of the planes, for the nodes they moved: the others are clear.
     for (std::size_t o = 0; o < planes_; ++o) {
@@ -824,14 +862,25 @@ void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) 
         const double d =
             (a.rx[i] - p.x) * n.x + (a.ry[i] - p.y) * n.y + (a.rz[i] - p.z) * n.z;
         const bool met = a.met[i] != 0;
-        deepest_lanes[i] = met ? std::max(deepest_lanes[i], -d) : deepest_lanes[i];
-        inside_lanes[i] = met && d < level ? 1.0 : inside_lanes[i];
+        deepest_lanes[i] = met & (deepest_lanes[i] < -d) ? -d : deepest_lanes[i];
+        inside_lanes[i] = met & (d < level) ? 1.0 : inside_lanes[i];
       }
     }
     // A lane the planes did not meet keeps its end as it was.
+    Vec3* end_out = lanes < kLanes ? tail_ends : ends + k0;
+    Vec3* start_out = lanes < kLanes ? tail_starts : starts + k0;
+    double* e_out = &end_out->x;
+    double* w_out = &start_out->x;
+#pragma omp simd
+    for (int i = 0; i < kLanes; ++i) {
+      e_out[3 * i] = a.rx[i], e_out[3 * i + 1] = a.ry[i], e_out[3 * i + 2] = a.rz[i];
+      w_out[3 * i] = wx[i], w_out[3 * i + 1] = wy[i], w_out[3 * i + 2] = wz[i];
+    }
+    if (lanes < kLanes) {
+      std::copy_n(tail_ends, lanes, ends + k0);
+      std::copy_n(tail_starts, lanes, starts + k0);
+    }
     for (int i = 0; i < lanes; ++i) {
-      ends[k0 + i] = {a.rx[i], a.ry[i], a.rz[i]};
-      starts[k0 + i] = {wx[i], wy[i], wz[i]};
       met_row[k0 + i] = static_cast<unsigned char>(a.met[i]);
       count += static_cast<int>(a.met[i]);
     }

@@ -171,7 +171,10 @@ void expect_the_walk_gives_the_response_alone(const std::vector<SolidSpec>& soli
 }
 
 // The floor's friction is low enough that some of its nodes slide and the others stick (the
-// walk's lanes take a shorter way when all stick); the tilted plane moves and turns.
+// walk's lanes take a shorter way when all stick); the tilted plane moves and turns. A plane
+// alone that does not turn takes another way (its lanes carry no normals nor surface
+// velocities): the floor alone, and a tilted floor moving without turning beside a sphere and a
+// box.
 TEST(Contact, TheRowWalkGivesTheSameResponseAsRespondAlone) {
   SolidSpec tilted = plane({0.0, 0.05, 0.0}, {0.3, 1.0, -0.2});
   tilted.motion = SolidMotion::kinematic;
@@ -188,6 +191,14 @@ TEST(Contact, TheRowWalkGivesTheSameResponseAsRespondAlone) {
   std::vector<SolidSpec> solids{floor, tilted, sphere({0.3, -0.05, 0.2}, 0.1), box};
   for (SolidSpec& s : solids) s.thickness = 4e-3;
   expect_the_walk_gives_the_response_alone(solids, false);
+  expect_the_walk_gives_the_response_alone({solids[0]}, false);
+  SolidSpec lifting = plane({0.0, 0.0, 0.0}, {0.1, 1.0, 0.05});
+  lifting.thickness = 4e-3;
+  lifting.friction = 0.15;
+  lifting.motion = SolidMotion::kinematic;
+  lifting.path.velocity = {0.2, 0.05, -0.1};
+  lifting.path.end_time = 10.0;
+  expect_the_walk_gives_the_response_alone({lifting, solids[2], solids[3]}, false);
   SolidSpec ceiling = plane({0.0, 0.001, 0.0}, {0.0, -1.0, 0.0});
   ceiling.thickness = 4e-3;
   expect_the_walk_gives_the_response_alone({solids[0], solids[1], ceiling}, true);

@@ -179,6 +179,7 @@ class Contact {
                                                 const Vec3& scheme_offset) const;
   // The planes for kLanes nodes at once, in lanes of doubles (see contact.cpp): the walk's.
   struct PlaneLanes;
+  template <bool OneStill>
   [[gnu::always_inline]] inline void meet_planes(PlaneLanes& lanes) const;
   // The height of r over plane s, along its normal.
   static double plane_height(const Solid& s, const Vec3& r) {
@@ -190,6 +191,8 @@ class Contact {
   double inside_level(double offset) const { return offset - 1e-9 * (offset + spacing_); }
   // The walk's two parts (walk_row); the planes' wide copy (grid/wide_copy.hpp).
   void walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next);
+  template <bool OneStill>
+  void walk_planes_of(int l, const Field<Vec3>& current, Field<Vec3>& next);
   void walk_planes_wide(int l, const Field<Vec3>& current, Field<Vec3>& next);
   void walk_boxes(int l, const Field<Vec3>& current, const Field<Vec3>& next);
   // An owned node's place in walk_met_ and walk_velocity_.
