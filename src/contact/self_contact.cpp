@@ -511,22 +511,33 @@ void SelfContact::build_candidates(double extent_sum) {
         lo[a] = std::min(lo[a], end_[p][a]) - reach;
         hi[a] = std::max(hi[a], end_[p][a]) + reach;
       }
-      candidates.clear();
-      const auto k = static_cast<std::int64_t>(p % m), l = static_cast<std::int64_t>(p / m);
-      // The boxes first: most cells fail them, and the test of the node's own cells divides.
+      // The node's own cells (up to four; a missing one is a cell no index names).
+      const std::size_t k = p % m, l = p / m, none = cells;
+      std::size_t own[4];
+      for (int corner = 0; corner < 4; ++corner) {
+        const std::size_t ck = k - (corner & 1), cl = l - (corner >> 1);
+        own[corner] = ck < cells_k && cl < cells / cells_k ? ck + cells_k * cl : none;
+      }
+      // Every cell met is written, and kept when its box meets the node's and it is not one of
+      // the node's own: tests and no branches, which mispredicted on cells that pass at random
+      // (42 % of those met in S6 x 5).
+      std::size_t kept = 0;
       auto consider = [&](std::size_t c) {
-        for (int a = 0; a < 3; ++a)
-          if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
-        const auto dk = static_cast<std::int64_t>(c % cells_k) - k;
-        const auto dl = static_cast<std::int64_t>(c / cells_k) - l;
-        if ((dk == 0 || dk == -1) && (dl == 0 || dl == -1)) return;
-        candidates.push_back(static_cast<std::int32_t>(c));
+        if (kept == candidates.size()) candidates.resize(2 * kept + 64);
+        const Vec3& clo = box_lo_[c];
+        const Vec3& chi = box_hi_[c];
+        const bool meets = !(chi.x < lo.x) & !(clo.x > hi.x) & !(chi.y < lo.y) & !(clo.y > hi.y) &
+                           !(chi.z < lo.z) & !(clo.z > hi.z);
+        const bool other = (c != own[0]) & (c != own[1]) & (c != own[2]) & (c != own[3]);
+        candidates[kept] = static_cast<std::int32_t>(c);
+        kept += static_cast<std::size_t>(meets & other);
       };
       each_cell_near(lo, hi, consider);
-      std::sort(candidates.begin(), candidates.end());
-      candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-      found.insert(found.end(), candidates.begin(), candidates.end());
-      list_start_[p + 1] = static_cast<std::uint32_t>(candidates.size());
+      const auto listed = candidates.begin() + static_cast<std::ptrdiff_t>(kept);
+      std::sort(candidates.begin(), listed);
+      const auto last = std::unique(candidates.begin(), listed);
+      found.insert(found.end(), candidates.begin(), last);
+      list_start_[p + 1] = static_cast<std::uint32_t>(last - candidates.begin());
     }
   }
   for (std::size_t p = 0; p < nodes; ++p) list_start_[p + 1] += list_start_[p];
