@@ -14,17 +14,19 @@ set(COSSERAT_TIME_SOURCES constraints.cpp dynamics.cpp scheme.cpp verlet_family.
 # Sets the per-file options on the sources under `root`/src, in the calling directory's scope.
 function(cosserat_source_options root)
   # The energy kernel's square roots vectorise only without errno (never read in this code).
+  # Its selections (a ? b : c, in the crushed cells' bound) vectorise for AVX2, which has no
+  # masked arithmetic, only where the compiler may compute both arms: without
+  # -ftrapping-math, which changes no result but lets an unselected arm raise a flag. A build
+  # that traps those flags keeps it.
   set(energy_options -fno-math-errno)
   if(NOT COSSERAT_TRAP_FPE)
     list(APPEND energy_options -fno-trapping-math)
   endif()
   set_source_files_properties(${root}/src/model/cosserat_energy.cpp
     PROPERTIES COMPILE_OPTIONS "${energy_options}")
-  # So do the contact's plane lanes, and only without the -frounding-math that CGAL's target
-  # adds to the module: no code of this file changes the rounding mode, or calls CGAL.
-  # The lanes' selections (a ? b : c) vectorise for AVX2, which has no masked arithmetic, only
-  # where the compiler may compute both arms: without -ftrapping-math, which changes no result
-  # but lets an unselected arm raise a flag. A build that traps those flags keeps it.
+  # The same for the contact's plane lanes (their square roots and selections), and only
+  # without the -frounding-math that CGAL's target adds to the module: no code of this file
+  # changes the rounding mode, or calls CGAL.
   set(contact_options -fno-math-errno -fno-rounding-math)
   if(NOT COSSERAT_TRAP_FPE)
     list(APPEND contact_options -fno-trapping-math)

@@ -483,7 +483,7 @@ Vec3 Contact::take_offset(int k, int l) {
 // is a long chain of dependent operations, and eight lanes left the core waiting on it
 // (benchmarks/results/contact-starts-*). OneStill: one plane that does not turn, whose normal
 // and velocity every lane it meets shares, so the lanes do not carry them (the benchmark's
-// plane 7.5 → 5.5 ns a node-step, benchmarks/results/contact-one-plane-*).
+// plane 7.5–8.5 → 5.0–6.1 ns a node-step, benchmarks/results/contact-one-plane-*).
 namespace {
 constexpr int kLanes = 16;
 // |t|² < (1 − 1e-12) s² with s > 0 gives √|t|², rounded, below s.

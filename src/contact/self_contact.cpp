@@ -424,7 +424,7 @@ bool SelfContact::through_cell(std::int32_t p, std::int32_t q, std::int32_t c) c
 void SelfContact::build_candidates(double extent_sum) {
   const std::size_t cells = box_lo_.size();
   const std::size_t nodes = end_.size();
-  const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
+  const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1, cells_l = cells / cells_k;
   const std::size_t held_cells = std::max<std::size_t>(present_cells_.size(), 1);
   const double spacing = std::max(extent_sum / static_cast<double>(held_cells), thickness_);
   const double inverse = 1.0 / spacing;
@@ -516,7 +516,7 @@ void SelfContact::build_candidates(double extent_sum) {
       std::size_t own[4];
       for (int corner = 0; corner < 4; ++corner) {
         const std::size_t ck = k - (corner & 1), cl = l - (corner >> 1);
-        own[corner] = ck < cells_k && cl < cells / cells_k ? ck + cells_k * cl : none;
+        own[corner] = ck < cells_k && cl < cells_l ? ck + cells_k * cl : none;
       }
       // Every cell met is written, and kept when its box meets the node's and it is not one of
       // the node's own: tests and no branches, which mispredicted on cells that pass at random
