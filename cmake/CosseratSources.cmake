@@ -18,19 +18,15 @@ function(cosserat_source_options root)
   # masked arithmetic, only where the compiler may compute both arms: without
   # -ftrapping-math, which changes no result but lets an unselected arm raise a flag. A build
   # that traps those flags keeps it.
-  set(energy_options -fno-math-errno)
-  if(NOT COSSERAT_TRAP_FPE)
-    list(APPEND energy_options -fno-trapping-math)
+  set(selections -fno-trapping-math)
+  if(COSSERAT_TRAP_FPE)
+    set(selections)
   endif()
   set_source_files_properties(${root}/src/model/cosserat_energy.cpp
-    PROPERTIES COMPILE_OPTIONS "${energy_options}")
+    PROPERTIES COMPILE_OPTIONS "-fno-math-errno;${selections}")
   # The same for the contact's plane lanes (their square roots and selections), and only
   # without the -frounding-math that CGAL's target adds to the module: no code of this file
   # changes the rounding mode, or calls CGAL.
-  set(contact_options -fno-math-errno -fno-rounding-math)
-  if(NOT COSSERAT_TRAP_FPE)
-    list(APPEND contact_options -fno-trapping-math)
-  endif()
   set_source_files_properties(${root}/src/contact/contact.cpp
-    PROPERTIES COMPILE_OPTIONS "${contact_options}")
+    PROPERTIES COMPILE_OPTIONS "-fno-math-errno;-fno-rounding-math;${selections}")
 endfunction()

@@ -488,6 +488,8 @@ namespace {
 constexpr int kLanes = 16;
 // |t|² < (1 − 1e-12) s² with s > 0 gives √|t|², rounded, below s.
 constexpr double kSureStick = 1.0 - 1e-12;
+// Whether a solid with angular velocity w turns.
+bool turns(const Vec3& w) { return w.x != 0.0 || w.y != 0.0 || w.z != 0.0; }
 }  // namespace
 
 struct Contact::PlaneLanes {
@@ -561,7 +563,7 @@ inline void Contact::meet_planes(PlaneLanes& a) const {
       }
       return sliding;
     };
-    const bool turning = !OneStill && (w.x != 0.0 || w.y != 0.0 || w.z != 0.0);
+    const bool turning = !OneStill && turns(w);
     const long sliding =
         turning ? approach.template operator()<true>() : approach.template operator()<false>();
     // Nodes lying still on a plane all stick: their lanes need no square root nor division.
@@ -764,8 +766,7 @@ void Contact::walk_row(int l, const Field<Vec3>& current, Field<Vec3>& next) {
 // the nodes it does not move, so the row of starts is whole. Which nodes it moved, and their
 // velocities after the planes, stay for prepare().
 void Contact::walk_planes(int l, const Field<Vec3>& current, Field<Vec3>& next) {
-  const Vec3 w = solids_[order_[0]].proposed.angular_velocity;
-  if (planes_ == 1 && w.x == 0.0 && w.y == 0.0 && w.z == 0.0)
+  if (planes_ == 1 && !turns(solids_[order_[0]].proposed.angular_velocity))
     walk_planes_of<true>(l, current, next);
   else
     walk_planes_of<false>(l, current, next);
