@@ -1,7 +1,8 @@
 # Sourced by the benchmark scripts: builds TARGET with PRESET and sets what every result file
 # records beside its numbers (date, host, cpu, compiler, git revision) and the stem
-# benchmarks/results/NAME-<host>-<date> of the result files; defines run_step_benchmark. Runs
-# from the repository root.
+# benchmarks/results/NAME-<host>-<date> of the result files (-2, -3, ... after it for a later run
+# the same day: a rerun never writes over a result); defines run_step_benchmark and claim_stem.
+# Runs from the repository root.
 #   source benchmarks/context.sh NAME PRESET TARGET
 # CONTEXT_BUILD=0 skips the build (a script given a prebuilt binary, e.g. run_parity.sh).
 if [ "${CONTEXT_BUILD:-1}" != 0 ]; then
@@ -12,10 +13,23 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 preset=$2
 date=$(date -u +%Y-%m-%d)
 host=$(hostname -s)
-stem=benchmarks/results/$1-$host-$date
+stem_base=benchmarks/results/$1-$host-$date
+stem=$stem_base
 cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
 compiler=$(c++ --version | head -1)
 revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+
+# Moves $stem on to $stem-2, -3, ... until no result file starts with it. A script that names
+# its files from a variant of the stem (e.g. a quick run's) sets stem from $stem_base and calls
+# this again.
+claim_stem() {
+  local base=$stem i=2
+  while compgen -G "$stem.*" >/dev/null || compgen -G "$stem-*" >/dev/null; do
+    stem=$base-$i
+    i=$((i + 1))
+  done
+}
+claim_stem
 
 # Google Benchmark 1.7 drops a --benchmark_context value holding a second '=' (and a program
 # whose main checks its flags stops), so the flags are named by their preset in

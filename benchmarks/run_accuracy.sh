@@ -11,6 +11,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source benchmarks/context.sh accuracy release cosserat
+# The day's files themselves, not a fresh stem: the parts merge into them (above).
+stem=$stem_base
 case " $* " in *" --quick "*) stem=$stem-quick ;; esac
 
 /usr/bin/python3 tools/accuracy_study.py --exe build/release/cosserat --out "$stem" "$@"

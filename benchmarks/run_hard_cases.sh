@@ -33,16 +33,13 @@ if [[ -z ${COSSERAT:-} ]]; then
   source benchmarks/context.sh hard-cases release cosserat
   COSSERAT=build/release/cosserat
 else
-  export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
-  date=$(date -u +%Y-%m-%d)
-  host=$(hostname -s)
-  stem=benchmarks/results/hard-cases-$host-$date
-  cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
-  compiler="$(c++ --version | head -1) (binary given as COSSERAT=$COSSERAT)"
-  revision=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+  CONTEXT_BUILD=0 source benchmarks/context.sh hard-cases none none
+  compiler="$compiler (binary given as COSSERAT=$COSSERAT)"
 fi
+stem=$stem_base
 ((self_contact)) && stem=${stem/hard-cases-/hard-cases-self-contact-}
 ((quick)) && stem=$stem-quick
+claim_stem
 export COSSERAT OMP_NUM_THREADS=${OMP_NUM_THREADS:-1}
 export HARD_TIMEOUT=${HARD_TIMEOUT:-1200} QUICK=$quick SELF_CONTACT=$self_contact
 work=$(mktemp -d)

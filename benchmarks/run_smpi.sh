@@ -20,7 +20,8 @@
 #    folded (--fold) and each step's computation is the calibrated time of the rank's block
 #    (--compute-ns, interpolated in B; past 4096 the 4096 figure, where the block streams from
 #    memory); the halo exchanges and reductions are the solver's own, timed by the simulation.
-# Writes benchmarks/results/smpi-<host>-<date>{-calibration.csv,-<study>.csv} and the tables
+# Writes benchmarks/results/smpi-<host>-<date>{-calibration.csv,-<study>.csv} (-2, -3, ... after
+# the date for a later run the same day, unless APPEND=1) and the tables
 # and plots of jobs/plot_scaling.py, -<strong>-<weak>.{md,png} (or -<study>.{md,png} alone).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -39,6 +40,10 @@ cmake -S benchmarks/smpi -B build/smpi -G Ninja -DCMAKE_CXX_COMPILER=smpicxx >/d
 cmake --build build/smpi -j "$(nproc)" >/dev/null
 date=$(date -u +%Y-%m-%d)
 stem=benchmarks/results/smpi-$(hostname -s)-$date
+for ((i = 2; ${APPEND:-0} != 1; ++i)); do  # a later run of the day beside the earlier ones
+  compgen -G "$stem.*" >/dev/null || compgen -G "$stem-*" >/dev/null || break
+  stem=benchmarks/results/smpi-$(hostname -s)-$date-$i
+done
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1
