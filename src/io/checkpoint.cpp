@@ -395,16 +395,21 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
     for (std::size_t i = 0; i < count && !problem; ++i) {
       const std::string name = fmt::format("action_state_{}", i);
       if (!file.has_attribute(name)) {
-        problem = fmt::format("cannot restart from '{}': it holds no state of the solids or "
-                              "the springs ({}); it was written for a scene without them",
-                              path, name);
+        problem = fmt::format(
+            "cannot restart from '{}': it holds no state of the solids, the "
+            "springs or self-contact ({}); it was written for a scene without "
+            "them",
+            path, name);
         break;
       }
       actions.push_back(file.read_doubles_attribute(name));
       for (const double x : actions.back())
         if (!std::isfinite(x)) {
-          problem = fmt::format("cannot restart from '{}': the solids' or springs' state ({}) "
-                                "holds a value that is not finite", path, name);
+          problem = fmt::format(
+              "cannot restart from '{}': the state of the solids, the springs or "
+              "self-contact ({}) "
+              "holds a value that is not finite",
+              path, name);
           break;
         }
     }

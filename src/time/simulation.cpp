@@ -151,13 +151,19 @@ class Simulation::SelfContactAction final : public StepAction {
     summary_.max_pairs = std::max(summary_.max_pairs, last_.contacts);
     summary_.closest = std::min(summary_.closest, last_.closest);
   }
+  // No pair yet has no closest distance (infinite), which a checkpoint holds as the largest
+  // double: its reader refuses any number that is not finite, and refused a run checkpointed
+  // before its cloth first touched itself.
   std::vector<double> state() const override {
-    return {static_cast<double>(summary_.max_pairs), summary_.closest};
+    return {static_cast<double>(summary_.max_pairs),
+            std::min(summary_.closest, std::numeric_limits<double>::max())};
   }
   void restore(const std::vector<double>& values) override {
     if (values.size() != 2) throw std::invalid_argument("self-contact state: two numbers");
     summary_.max_pairs = static_cast<long>(values[0]);
-    summary_.closest = values[1];
+    summary_.closest = values[1] == std::numeric_limits<double>::max()
+                           ? std::numeric_limits<double>::infinity()
+                           : values[1];
   }
   const SelfContactSummary& summary() const { return summary_; }
 

@@ -328,6 +328,34 @@ TEST_F(Cli, RestartContinuesARunBitwise) {
   EXPECT_THAT(json.str(), HasSubstr("\"restarted_from\": 120"));
 }
 
+// With self-contact on, a checkpoint written before the cloth ever touches itself (no pair, so no
+// closest distance yet) restarts as any other, to the uninterrupted run's last frame; it was
+// refused as holding a number that is not finite.
+TEST_F(Cli, RestartWithSelfContactBeforeAnyPairContinuesBitwise) {
+  std::string text = std::string(kSmallScene) + "[self_contact]\n";
+  text.replace(text.find("phi = 0.001\n"), 12, "phi = 0.001\nthickness = 0.001\n");
+  const std::string scene = write_scene("s.toml", text);
+  ASSERT_EQ(
+      cosserat("run " + scene + " -q -o " + path("whole.h5") + " --summary " + path("whole.json"))
+          .status,
+      0);
+  std::stringstream summary;
+  summary << std::ifstream(path("whole.json")).rdbuf();
+  ASSERT_THAT(summary.str(), HasSubstr(R"("max_pairs": 0, "closest": null)")) << summary.str();
+  ASSERT_EQ(cosserat("run " + scene + " -q --set time.steps=120 --checkpoint-every 50 -o " +
+                     path("part.h5"))
+                .status,
+            0);
+  const Result second = cosserat("run " + scene + " -q --restart " + path("part.checkpoint.h5") +
+                                 " -o " + path("part.h5"));
+  ASSERT_EQ(second.status, 0) << second.output;
+  const auto whole = read_datasets(path("whole.h5")), part = read_datasets(path("part.h5"));
+  const std::size_t frame_bytes = 6 * 6 * 3 * sizeof(double);
+  ASSERT_GE(part[0].size(), frame_bytes);
+  EXPECT_TRUE(std::equal(part[0].end() - frame_bytes, part[0].end(), whole[0].end() - frame_bytes))
+      << "the last frames differ";
+}
+
 // Issue 12: a restart continues only the output of the run it restarts. Another scene's file and
 // a file of the same scene that lacks frames before the checkpoint are refused, unchanged.
 TEST_F(Cli, RestartIntoAnotherRunsOutputIsBadInput) {
