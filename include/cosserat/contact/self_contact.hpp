@@ -142,7 +142,7 @@ class SelfContact {
   std::vector<double> cell_extents_;             // the largest side of each held cell's box
 
   // A triangle's plane: its normal times twice its area at the step's start, and its unit
-  // normal at the end.
+  // normal at the end; area0 is 0 for a triangle that turned over in the step (cell_planes).
   struct Plane {
     Vec3 normal0;
     double area0;
