@@ -85,10 +85,11 @@ Vec3 velocity_of(int k, int l, double dt, const Field<Vec3>& current, const Fiel
 }
 
 // The buckets of each 4 x 4 x 4 block of space lie side by side (64 of them, 256 bytes of
-// bucket_start_), and the blocks are hashed: a cell's box covers up to 8 buckets, and the cells
+// bucket_start_), and the blocks are hashed. A cell's box covers about 8 buckets, and the cells
 // and nodes come in the grid's order, whose neighbours lie near in space, so the fill and the
-// lists read and write a few lines of memory where a hash of each bucket scattered them over
-// the whole table (S6 with its loads x 5 at 240²: 13 % of the time in the serial fill).
+// lists touch a few lines of memory where a hash of each bucket scattered them over the whole
+// table: on S6 with its loads x 5 at 240² the builds' samples fell from 1.34 to 0.86 times the
+// force kernel's (docs/contact.md, "Cost"). Any function of the bucket gives the same lists.
 std::uint64_t bucket_of(std::int64_t i, std::int64_t j, std::int64_t k, std::uint64_t mask) {
   const auto block = static_cast<std::uint64_t>(i >> 2) * 73856093u ^
                      static_cast<std::uint64_t>(j >> 2) * 19349663u ^
@@ -626,16 +627,12 @@ double SelfContact::cell_box(std::size_t c) {
   const auto m = static_cast<std::size_t>(block_->m), cells_k = m - 1;
   const std::size_t n00 = c % cells_k + m * (c / cells_k);
   Vec3 lo = start_[n00], hi = lo;
-  // Component by component on the arrays: looping over braced lists of the points copied
-  // each, and cost 220 instructions a cell (callgrind, S6 with its loads x 5).
-  const auto widen = [&](const Vec3& x) {
-    lo.x = std::min(lo.x, x.x), lo.y = std::min(lo.y, x.y), lo.z = std::min(lo.z, x.z);
-    hi.x = std::max(hi.x, x.x), hi.y = std::max(hi.y, x.y), hi.z = std::max(hi.z, x.z);
-  };
-  for (const std::size_t i : std::array{n00, n00 + 1, n00 + m, n00 + m + 1}) {
-    widen(start_[i]);
-    widen(end_[i]);
-  }
+  for (const std::size_t i : {n00, n00 + 1, n00 + m, n00 + m + 1})
+    for (const Vec3& x : {start_[i], end_[i]})
+      for (int a = 0; a < 3; ++a) {
+        lo[a] = std::min(lo[a], x[a]);
+        hi[a] = std::max(hi[a], x[a]);
+      }
   box_lo_[c] = lo;
   box_hi_[c] = hi;
   return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
@@ -963,9 +960,9 @@ void SelfContact::relax() {
     for (int i = 0; i < 4; ++i) share_[static_cast<std::size_t>(q.nodes[i])] = 0.0;
 }
 
-// Each node its pairs reached takes its sum, which is cleared; it is moved_ from the first
-// (pending_ keeps the order in which the pass reached its nodes, so moved_ is in the order the
-// passes first reached them).
+// Each node its pairs reached takes its sum, which is cleared, and joins moved_ the first time:
+// pending_ holds a pass's nodes in the order its pairs reached them, so moved_ lists them in the
+// order the passes first reached them.
 template <class Take>
 void SelfContact::take_sums(std::vector<Vec3>& sums, Take take) {
   for (const std::int32_t node : pending_) {

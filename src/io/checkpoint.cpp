@@ -396,9 +396,8 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
       const std::string name = fmt::format("action_state_{}", i);
       if (!file.has_attribute(name)) {
         problem = fmt::format(
-            "cannot restart from '{}': it holds no state of the solids, the "
-            "springs or self-contact ({}); it was written for a scene without "
-            "them",
+            "cannot restart from '{}': it holds no state of the solids, the springs or "
+            "self-contact ({}); it was written for a scene without them",
             path, name);
         break;
       }
@@ -406,9 +405,8 @@ long read_checkpoint(const std::string& path, Simulation& simulation, const Scen
       for (const double x : actions.back())
         if (!std::isfinite(x)) {
           problem = fmt::format(
-              "cannot restart from '{}': the state of the solids, the springs or "
-              "self-contact ({}) "
-              "holds a value that is not finite",
+              "cannot restart from '{}': the state of the solids, the springs or self-contact "
+              "({}) holds a value that is not finite",
               path, name);
           break;
         }
