@@ -38,12 +38,9 @@ for tool in smpicxx smpirun; do
 done
 cmake -S benchmarks/smpi -B build/smpi -G Ninja -DCMAKE_CXX_COMPILER=smpicxx >/dev/null
 cmake --build build/smpi -j "$(nproc)" >/dev/null
-date=$(date -u +%Y-%m-%d)
-stem=benchmarks/results/smpi-$(hostname -s)-$date
-for ((i = 2; ${APPEND:-0} != 1; ++i)); do  # a later run of the day beside the earlier ones
-  compgen -G "$stem.*" >/dev/null || compgen -G "$stem-*" >/dev/null || break
-  stem=benchmarks/results/smpi-$(hostname -s)-$date-$i
-done
+CONTEXT_BUILD=0 source benchmarks/context.sh smpi none none
+# APPEND adds to the day's own logs, not to a fresh stem's.
+[[ ${APPEND:-0} == 1 ]] && stem=$stem_base
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 export OMP_NUM_THREADS=1
@@ -84,7 +81,6 @@ fi
 
 jobs/make_large_sheet.sh 256 100 "$work/sheet.toml"
 revision=$(git rev-parse --short=12 HEAD 2>/dev/null || echo unknown)
-cpu=$(lscpu | sed -n 's/^Model name: *//p' | head -1)
 run_study() {  # name kind grid|per-rank ranks...
   local name=$1 kind=$2 size=$3 log=$stem-$1.csv
   shift 3

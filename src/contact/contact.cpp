@@ -794,6 +794,7 @@ void Contact::walk_planes_of(int l, const Field<Vec3>& current, Field<Vec3>& nex
   Vec3* starts = &(*walk_starts_)(b.k0, l);
   // A row's last block, when shorter than the lanes, goes through these.
   Vec3 tail_origins[kLanes], tail_ends[kLanes], tail_starts[kLanes];
+  const Solid& still = solids_[order_[0]];  // OneStill's plane
   for (int k0 = 0; k0 < b.owned_k(); k0 += kLanes) {
     // A row's last lanes repeat its last node, and are not read.
     const int lanes = std::min(kLanes, b.owned_k() - k0);
@@ -834,7 +835,6 @@ void Contact::walk_planes_of(int l, const Field<Vec3>& current, Field<Vec3>& nex
     // settled() of the velocity the node leaves with, operation for operation, as
     // settled_velocity() finds it on a prepared tile; then VerletFamily::set_velocities' r⁻
     // of it, the same way.
-    const Solid& still = solids_[order_[0]];
 #pragma omp simd
     for (int i = 0; i < kLanes; ++i) {
       const double mx = (a.rx[i] - sx[i]) * rate, my = (a.ry[i] - sy[i]) * rate,
