@@ -21,8 +21,13 @@ constexpr int kPasses = 8;
 constexpr double kOnFloor = 1e-6;
 
 // The candidate lists' margin, in grid spacings: a node's box at a build, grown by it, meets the
-// cells of its own four in a flat sheet, and the lists serve until a node moves half of it.
+// cells of its own four in a flat sheet. The lists serve until a node moves its leeway from
+// where it was at the build: half the margin, or for a node that moves fast what its step at
+// the build takes it in kLead steps, up to kMostLeeway margins. A few fast nodes (the folds of
+// S6 with its loads x 5 at 240²) otherwise rebuild every node's list every few steps.
 constexpr double kMargin = 0.25;
+constexpr double kLead = 8.0;
+constexpr double kMostLeeway = 2.0;
 
 // Numbers per node sent to another rank: its number k + m l, start, end, velocity and the held
 // mark.
@@ -30,9 +35,9 @@ constexpr int kPerNode = 11;
 
 // Numbers per rank in the exchange of what its nodes reach (SelfContact::gather): the box of its
 // nodes over the step (low and high corners), the largest extent at the step's start of the
-// cells whose first corner it owns, the farthest one of its nodes moves in a coordinate, and
-// whether all its positions are finite.
-constexpr int kReach = 9;
+// cells whose first corner it owns, the farthest one of its nodes moves in a coordinate,
+// whether all its positions are finite, and the largest leeway of its nodes at its last build.
+constexpr int kReach = 10;
 
 // How many pairs apart the response can carry a node's state to another's: each pass of the
 // positions and of the velocities moves a node by its pairs' moves, one pair further each pass,
@@ -157,6 +162,8 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   const auto cells = static_cast<std::size_t>(block.m - 1) * static_cast<std::size_t>(block.n - 1);
   box_lo_.resize(cells);
   box_hi_.resize(cells);
+  leeway_.assign(nodes, 0.5 * margin_);
+  cell_leeway_.resize(cells);
   needed_.assign(cells, 0);
   const int m = block.m, n = block.n;
   const int horizontal = (m - 1) * n;
@@ -183,21 +190,23 @@ bool SelfContact::on_floor(const Vec3& x) const {
 // The nodes whose state of the step this rank needs (docs/contact.md, "Self-contact", "Parallel
 // runs and restarts"): its own and every node of another rank within kHops pairs of them, so
 // that the response below, the same computation on every rank over the nodes it holds, gives
-// its own nodes the bits one rank would. The two nodes of a pair lie within 2t + margin + 2D
-// of each other in every coordinate, their boxes over the step taken, D the largest side of a
-// cell's box over the step: a node is within t of a triangle's cell box, which holds the
+// its own nodes the bits one rank would. The two nodes of a pair, or of a candidate the lists
+// hold, lie within 2t + 2L + 2D of each other in every coordinate, their boxes over the step
+// taken, L the largest leeway of a node (find_pairs) and D the largest side of a cell's box over
+// the step: a node is within t of a triangle's cell box, which holds the
 // corners' boxes; two edges' nearest points are within t at the step's end, or met within t
 // of both edges during it, and each node lies within an edge's extent of them. D is at most
 // the largest extent of a cell's corners at the step's start plus twice the farthest any node
 // moves in a coordinate. So a rank needs the nodes whose box lies within the reach
-// R = kHops (2t + margin + 2D) of its own nodes' box, and is sent those within kSpare R.
+// R = kHops (2t + 2L + 2D) of its own nodes' box, and is sent those within kSpare R.
 // Whether every position is finite, on every rank.
 bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
                          const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
                          const std::vector<char>& held) {
   const Block& b = *block_;
   bool finite = true;
-  // How far a node has gone from where the candidate lists were built (find_pairs).
+  // How much farther than its leeway a node has gone from where the candidate lists were built
+  // (find_pairs): the lists serve while no node has.
   const bool built = !built_.empty();
   drift_ = built ? 0.0 : std::numeric_limits<double>::infinity();
   // One node's positions into the whole grid's arrays at i = k + m l, into a thread's own
@@ -206,9 +215,13 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
     start_[i] = r;
     end_[i] = r1;
     all_finite = all_finite && is_finite(r) && is_finite(r1);
-    if (built)
+    if (built) {
+      double moved = 0.0;
       for (int a = 0; a < 3; ++a)
-        drift = std::max({drift, std::abs(r[a] - built_[i][a]), std::abs(r1[a] - built_[i][a])});
+        moved = std::max({moved, std::abs(r[a] - built_[i][a]), std::abs(r1[a] - built_[i][a])});
+      // Exact: of two finite doubles, the difference is positive only where the first is larger.
+      drift = std::max(drift, moved - leeway_[i]);
+    }
   };
   const auto m = static_cast<std::size_t>(b.m);
   // One rank: no message, and the velocities and masses only of the nodes the pairs reach
@@ -226,11 +239,13 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
   }
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   double mine[kReach] = {kInfinity,  kInfinity, kInfinity, -kInfinity, -kInfinity,
-                         -kInfinity, 0.0,       0.0,       1.0};
+                         -kInfinity, 0.0,       0.0,       1.0,        0.0};
   for (int l = b.l0; l < b.l1; ++l)
     for (int k = b.k0; k < b.k1; ++k) {
       const Vec3 &r = current(k, l), &r1 = next(k, l);
       if (!is_finite(r) || !is_finite(r1)) mine[8] = 0.0;
+      mine[9] =
+          std::max(mine[9], leeway_[static_cast<std::size_t>(k) + m * static_cast<std::size_t>(l)]);
       for (int a = 0; a < 3; ++a) {
         mine[a] = std::min({mine[a], r[a], r1[a]});
         mine[3 + a] = std::max({mine[3 + a], r[a], r1[a]});
@@ -245,14 +260,15 @@ bool SelfContact::gather(const Field<Vec3>& current, const Field<Vec3>& next,
         }
     }
   MPI_Allgather(mine, kReach, MPI_DOUBLE, reach_.data(), kReach, MPI_DOUBLE, b.comm);
-  double extent = 0.0, farthest = 0.0;
+  double extent = 0.0, farthest = 0.0, leeway = 0.0;
   for (int rank = 0; rank < ranks_; ++rank) {
     const double* other = &reach_[kReach * static_cast<std::size_t>(rank)];
     if (!(other[8] != 0.0)) return false;
     extent = std::max(extent, other[6]);
     farthest = std::max(farthest, other[7]);
+    leeway = std::max(leeway, other[9]);
   }
-  const double reach = kHops * (2.0 * thickness_ + margin_ + 2.0 * (extent + 2.0 * farthest));
+  const double reach = kHops * (2.0 * thickness_ + 2.0 * leeway + 2.0 * (extent + 2.0 * farthest));
   // Sent: the nodes within half as far again, so that the nodes a rank holds serve it for many
   // steps of a moving sheet (below).
   const double sent = kSpare * reach;
@@ -423,11 +439,12 @@ bool SelfContact::through_cell(std::int32_t p, std::int32_t q, std::int32_t c) c
   return false;
 }
 
-// Every cell's box over the step goes into the buckets of a spatial hash whose spacing is the
-// mean box, with eight buckets a cell; each node's box over the step, grown by the thickness and
-// the margin, meets the cells of the buckets it covers. (Twice that spacing with two buckets a
-// cell: 40 s against 33 s on scenes/hard/s6_loads_x5.toml, the same pairs.) Each node's cells
-// are kept in increasing order, so that the pairs come in the same order whatever the build.
+// Every cell's box over the step, grown by its leeway, goes into the buckets of a spatial hash
+// whose spacing is the mean box, with eight buckets a cell; each node's box over the step, grown
+// by the thickness and its own leeway, meets the cells of the buckets it covers. (Twice that
+// spacing with two buckets a cell: 40 s against 33 s on scenes/hard/s6_loads_x5.toml, the same
+// pairs.) Each node's cells are kept in increasing order, so that the pairs come in the same order
+// whatever the build.
 void SelfContact::build_candidates(double extent_sum) {
   const std::size_t cells = box_lo_.size();
   const std::size_t nodes = end_.size();
@@ -447,13 +464,36 @@ void SelfContact::build_candidates(double extent_sum) {
     }
     return count;
   };
+
+  // Each node's leeway (kLead) from its move in this step, and each cell's, the largest of its
+  // corners': a cell's box then stays within its leeway of its box now while no node has gone
+  // farther than its own.
+  const double least = 0.5 * margin_, most = kMostLeeway * margin_;
+#pragma omp parallel for schedule(static)
+  for (std::size_t at = 0; at < present_nodes_.size(); ++at) {
+    const auto p = static_cast<std::size_t>(present_nodes_[at]);
+    double move = 0.0;
+    for (int a = 0; a < 3; ++a) move = std::max(move, std::abs(end_[p][a] - start_[p][a]));
+    leeway_[p] = std::clamp(kLead * move, least, most);
+  }
+  auto grown = [](const Vec3& x, double by) { return Vec3{x.x + by, x.y + by, x.z + by}; };
+#pragma omp parallel for schedule(static)
+  for (std::size_t at = 0; at < present_cells_.size(); ++at) {
+    const auto c = static_cast<std::size_t>(present_cells_[at]);
+    const std::size_t n00 = c % cells_k + m * (c / cells_k);
+    cell_leeway_[c] =
+        std::max({leeway_[n00], leeway_[n00 + 1], leeway_[n00 + m], leeway_[n00 + m + 1]});
+  }
+
   bucket_start_.assign(buckets + 1, 0);
   large_cells_.clear();
   std::int64_t first[3], last[3];
   for (int pass = 0; pass < 2; ++pass) {
     for (const std::int32_t cell : present_cells_) {
       const auto c = static_cast<std::size_t>(cell);
-      if (range(box_lo_[c], box_hi_[c], first, last) > kMostBuckets) {
+      const double leeway = cell_leeway_[c];
+      if (range(grown(box_lo_[c], -leeway), grown(box_hi_[c], leeway), first, last) >
+          kMostBuckets) {
         if (pass == 0) large_cells_.push_back(static_cast<std::int32_t>(c));
         continue;
       }
@@ -495,7 +535,6 @@ void SelfContact::build_candidates(double extent_sum) {
     for (const std::int32_t c : large_cells_) consider(static_cast<std::size_t>(c));
   };
 
-  const double reach = thickness_ + margin_;
   list_start_.assign(nodes + 1, 0);
   // Each thread lists a static chunk of the nodes, counting each node's cells into
   // list_start_; the chunks joined in thread order are the lists in node order, the same for
@@ -513,6 +552,7 @@ void SelfContact::build_candidates(double extent_sum) {
 #pragma omp for schedule(static)
     for (std::size_t at = 0; at < present_nodes_.size(); ++at) {
       const auto p = static_cast<std::size_t>(present_nodes_[at]);
+      const double reach = thickness_ + leeway_[p];
       Vec3 lo = start_[p], hi = lo;
       for (int a = 0; a < 3; ++a) {
         lo[a] = std::min(lo[a], end_[p][a]) - reach;
@@ -531,8 +571,8 @@ void SelfContact::build_candidates(double extent_sum) {
       std::size_t kept = 0;
       auto consider = [&](std::size_t c) {
         if (kept == candidates.size()) candidates.resize(2 * kept + 64);
-        const Vec3& clo = box_lo_[c];
-        const Vec3& chi = box_hi_[c];
+        const Vec3 clo = grown(box_lo_[c], -cell_leeway_[c]);
+        const Vec3 chi = grown(box_hi_[c], cell_leeway_[c]);
         const bool meets = !(chi.x < lo.x) & !(clo.x > hi.x) & !(chi.y < lo.y) & !(clo.y > hi.y) &
                            !(chi.z < lo.z) & !(clo.z > hi.z);
         const bool other = (c != own[0]) & (c != own[1]) & (c != own[2]) & (c != own[3]);
@@ -559,18 +599,21 @@ void SelfContact::build_candidates(double extent_sum) {
     if (listed_mark_[c] != 0) listed_.push_back(static_cast<std::int32_t>(c));
 
   // Each border edge meets the edges of the cells its box, grown as a node's, finds in the
-  // hash, where those edges' own boxes meet it and every node of one is more than two apart
-  // from every node of the other in k or l. Nearer edges are the fold of a cell or two, which
-  // the bending holds, and which a cloth hung from a corner makes there: held apart, the
-  // corner's edges and those two cells on fought the fold and threw a node
+  // hash, where those edges' own boxes, grown by their leeways, meet it and every node of one is
+  // more than two apart from every node of the other in k or l. Nearer edges are the fold of a cell
+  // or two, which the bending holds, and which a cloth hung from a corner makes there: held apart,
+  // the corner's edges and those two cells on fought the fold and threw a node
   // (scenes/hard/denim_square.toml stopped at 2.35 s with them).
   edge_candidates_.clear();
   const auto mi = static_cast<std::int32_t>(m);
   const std::int32_t horizontal = (mi - 1) * block_->n;
   const std::int32_t diagonals = horizontal + mi * (block_->n - 1);
   const auto cells_i = static_cast<std::int32_t>(cells);
+  // An edge's box over the step grown by `grow` and its nodes' larger leeway.
   auto edge_box = [&](std::int32_t edge, double grow, Vec3& lo, Vec3& hi) {
     const auto nodes = edge_nodes(edge);
+    grow += std::max(leeway_[static_cast<std::size_t>(nodes[0])],
+                     leeway_[static_cast<std::size_t>(nodes[1])]);
     lo = start_[static_cast<std::size_t>(nodes[0])];
     hi = lo;
     for (const std::int32_t node : nodes)
@@ -591,11 +634,12 @@ void SelfContact::build_candidates(double extent_sum) {
         present_[static_cast<std::size_t>(mine[1])] == 0)
       continue;
     Vec3 lo, hi;
-    edge_box(e, reach, lo, hi);
+    edge_box(e, thickness_, lo, hi);
     sides.clear();
     auto consider = [&](std::size_t c) {
       for (int a = 0; a < 3; ++a)
-        if (box_hi_[c][a] < lo[a] || box_lo_[c][a] > hi[a]) return;
+        if (box_hi_[c][a] + cell_leeway_[c] < lo[a] || box_lo_[c][a] - cell_leeway_[c] > hi[a])
+          return;
       const auto ck = static_cast<std::int32_t>(c % cells_k);
       const auto cl = static_cast<std::int32_t>(c / cells_k);
       const auto cell = static_cast<std::int32_t>(c);
@@ -667,17 +711,17 @@ void SelfContact::cell_planes(std::size_t c) {
 // itself is held at the thickness as two layers anywhere else are, from one cell beyond the
 // crease's nodes; within a cell the bending holds the fold (docs/contact.md, "Self-contact").
 void SelfContact::find_pairs() {
-  // The candidates of the last build serve while no node has moved more than half the margin
-  // from where it was then (in any coordinate): a cell's box over any later step then lies
-  // within half the margin of its box at the build, and a node's within half the margin of
-  // the node then, so a cell that a node's box grown by the thickness meets later was met by
-  // its box at the build grown by the thickness and the margin. Which steps rebuild changes
-  // no pair: the lists only hold more cells than the test below keeps.
+  // The candidates of the last build serve while no node has moved more than its leeway from
+  // where it was then (in any coordinate): a cell's box over any later step then lies within
+  // the cell's leeway of its box at the build, and a node's within its own of the node then,
+  // so a cell that a node's box grown by the thickness meets later was met, both boxes at the
+  // build grown by their leeways, the node's by the thickness too. Which steps rebuild, and
+  // which leeways, change no pair: the lists only hold more cells than the test below keeps.
   // Only the cells in some node's list need their box and planes between builds: in a sheet
   // that does not touch itself, none. The boxes, the planes and the pairs on the rank's threads
   // in static chunks; the threads' pairs joined in thread order are the pairs in row order, the
   // same for any count.
-  if (!(drift_ <= 0.5 * margin_)) {
+  if (!(drift_ <= 0.0)) {
     cell_extents_.resize(present_cells_.size());
 #pragma omp parallel for schedule(static)
     for (std::size_t e = 0; e < present_cells_.size(); ++e)

@@ -291,6 +291,31 @@ TEST(SelfContact, ARestoredRunRepeatsItsStepsBitwise) {
   expect_the_same_bits(positions(sim), first);
 }
 
+// The candidate lists serve a node while it stays within its leeway of where they were built,
+// a fast node's longer (docs/contact.md, "Cost"): the layers thrown at each other across and
+// sideways, by a run that keeps its lists from step to step, end bitwise where a chain of new
+// runs ends, each taking one step from the last one's state and so building its lists anew
+// every step.
+TEST(SelfContact, ListsKeptOverStepsFindThePairsOfListsBuiltEveryStep) {
+  Scene s = testing::layered_sheet(2e-3);
+  s.dt = 1e-4;
+  Simulation kept(s, MPI_COMM_SELF);
+  testing::fold(kept, s, 0.0, 0.03, {3.0, -12.0, 1.0}, {-1.0, 2.0, 0.0});
+  Stepper::Snapshot state = kept.stepper().snapshot();
+  constexpr int kSteps = 80;
+  for (int step = 0; step < kSteps; ++step) {
+    Simulation anew(s, MPI_COMM_SELF);
+    anew.stepper().restore(state);
+    ASSERT_FALSE(anew.step()) << "step " << step;
+    state = anew.stepper().snapshot();
+  }
+  ASSERT_TRUE(testing::advance(kept, kSteps));
+  EXPECT_GT(kept.self_contact_summary()->max_pairs, 0);
+  Simulation chained(s, MPI_COMM_SELF);
+  chained.stepper().restore(state);
+  expect_the_same_bits(positions(chained), positions(kept));
+}
+
 // The pairs are found on the rank's threads, each thread's joined in row order: a layer fired
 // onto another gives the same bits on one thread and on three.
 TEST(SelfContact, ThreadsGiveTheSameBits) {

@@ -51,8 +51,9 @@ class SelfContact {
 
   // About what one rank holds for an m x n grid: arrays over the whole grid for the state of
   // the step of the nodes it holds, six positions or velocities a node and, at most, 11 numbers
-  // received for each (400 bytes with the candidate lists), and each cell's box, four planes and
-  // eight buckets (370 bytes); the pairs come on top, a few per node in contact.
+  // received for each (410 bytes with the candidate lists and the leeway), and each cell's box,
+  // leeway, four planes and eight buckets (380 bytes); the pairs come on top, a few per node in
+  // contact.
   static double memory_bytes(int m, int n) { return 800.0 * m * n; }
 
  private:
@@ -166,7 +167,10 @@ class SelfContact {
   std::vector<std::uint32_t> list_start_;
   std::vector<std::int32_t> list_cells_;
   std::vector<Vec3> built_;
-  double drift_ = 0.0;  // the farthest any node has gone from built_, in one coordinate, m
+  // How far each node, and each cell's corners, may go from built_ in a coordinate before the
+  // lists are built again (find_pairs), m.
+  std::vector<double> leeway_, cell_leeway_;
+  double drift_ = 0.0;  // how much farther than its leeway a node has gone from built_, m
   // The cells in some node's list, in increasing order: those whose box and planes a step
   // needs.
   std::vector<std::int32_t> listed_;
