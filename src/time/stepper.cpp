@@ -137,7 +137,9 @@ void Stepper::restore_action_states(const std::vector<std::vector<double>>& stat
 
 void Stepper::restore(const Snapshot& s) {
   const std::vector<StateField> fields = scheme_->state_fields();
-  for (std::size_t i = 0; i < fields.size(); ++i) *fields[i].field = s.fields[i];
+  // Values only: a snapshot's fields name the block of the run that took it, which may have
+  // ended (a snapshot restored into another run of the same scene).
+  for (std::size_t i = 0; i < fields.size(); ++i) fields[i].field->assign_values(s.fields[i]);
   constraints_.restore(s.constraints);
   restore_action_states(s.actions);
   resume(s.step, s.time, s.last_dt);

@@ -302,27 +302,19 @@ TEST(SelfContact, ListsKeptOverStepsFindThePairsOfListsBuiltEveryStep) {
   Simulation kept(s, MPI_COMM_SELF);
   testing::fold(kept, s, 0.0, 0.03, {3.0, -12.0, 1.0}, {-1.0, 2.0, 0.0});
   // A snapshot's fields name the block of the run that took it, which a chained run outlives:
-  // each run restores the values on its own block.
-  auto restore = [](Simulation& sim, Stepper::Snapshot state) {
-    for (Field<Vec3>& field : state.fields) {
-      Field<Vec3> values(sim.block());
-      std::copy_n(field.data(), sim.block().local_size(), values.data());
-      field.swap(values);
-    }
-    sim.stepper().restore(state);
-  };
+  // Stepper::restore takes their values only.
   Stepper::Snapshot state = kept.stepper().snapshot();
   constexpr int kSteps = 80;
   for (int step = 0; step < kSteps; ++step) {
     Simulation anew(s, MPI_COMM_SELF);
-    restore(anew, state);
+    anew.stepper().restore(state);
     ASSERT_FALSE(anew.step()) << "step " << step;
     state = anew.stepper().snapshot();
   }
   ASSERT_TRUE(testing::advance(kept, kSteps));
   EXPECT_GT(kept.self_contact_summary()->max_pairs, 0);
   Simulation chained(s, MPI_COMM_SELF);
-  restore(chained, state);
+  chained.stepper().restore(state);
   expect_the_same_bits(positions(chained), positions(kept));
 }
 

@@ -10,6 +10,7 @@
 #include <cassert>
 #include <cstddef>
 #include <memory>
+#include <stdexcept>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -122,6 +123,13 @@ class Field {
   void swap(Field& other) noexcept {
     std::swap(block_, other.block_);
     data_.swap(other.data_);
+  }
+  // The values of a field of a block of the same shape, this field keeping its own block: a
+  // copy (operator=) takes the other's, which may have ended with the run that made it.
+  void assign_values(const Field& other) {
+    if (other.data_.size() != data_.size())
+      throw std::logic_error("Field::assign_values: the fields' blocks differ in size");
+    std::copy(other.data_.begin(), other.data_.end(), data_.begin());
   }
 
  private:
