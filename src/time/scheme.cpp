@@ -1,5 +1,6 @@
 #include "cosserat/time/scheme.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "explicit_schemes.hpp"
@@ -33,6 +34,19 @@ void Scheme::exchange_next_positions(bool changed) {
 void Scheme::accept() {
   accept_state();
   positions_.swap(next_positions_);
+}
+
+double Scheme::max_speed2() {
+  const Block& b = context_.block;
+  const Field<Vec3>& v = velocities();
+  double most = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : most)
+  for (int l = b.l0; l < b.l1; ++l) {
+    const Vec3* row = &v(b.k0, l);
+#pragma omp simd reduction(max : most)
+    for (int i = 0; i < b.owned_k(); ++i) most = std::max(most, dot(row[i], row[i]));
+  }
+  return most;
 }
 
 void Scheme::resume(double last_dt) {

@@ -1,5 +1,7 @@
 #include "cosserat/time/scheme.hpp"
 
+#include <algorithm>
+
 #include "explicit_schemes.hpp"
 
 namespace cosserat {
@@ -188,6 +190,26 @@ const Field<Vec3>& VerletFamily::velocities() {
     velocities_current_ = true;
   }
   return velocity_report_;
+}
+
+// velocities()'s largest |v|², without writing the field where it is not current: the adaptive
+// step reads it before every step (docs/stability.md, "Adaptive steps", its cost).
+double VerletFamily::max_speed2() {
+  if (velocities_current_) return Scheme::max_speed2();
+  const Block& b = context_.block;
+  const double dt = dt_previous_;
+  double most = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : most)
+  for (int l = b.l0; l < b.l1; ++l) {
+    const Vec3* r = &positions_(b.k0, l);
+    const Vec3* rp = &previous_positions_(b.k0, l);
+#pragma omp simd reduction(max : most)
+    for (int i = 0; i < b.owned_k(); ++i) {
+      const Vec3 v = (r[i] - rp[i]) / dt;
+      most = std::max(most, dot(v, v));
+    }
+  }
+  return most;
 }
 
 std::vector<Scheme::StateField> VerletFamily::state_fields() {

@@ -100,6 +100,9 @@ class Scheme {
 
   // The velocity at the current time (see Stepper::velocities).
   virtual const Field<Vec3>& velocities() = 0;
+  // The largest |v|² of velocities() over the owned nodes (the adaptive step's estimate reads
+  // it before every step).
+  virtual double max_speed2();
 
   // Together with the step index and the constraints' state, all a restart needs.
   virtual std::vector<StateField> state_fields() = 0;
@@ -157,6 +160,7 @@ class VerletFamily : public Scheme {
   }
   // The backward difference (r − r⁻)/Δt: the velocity half a step back.
   const Field<Vec3>& velocities() override;
+  double max_speed2() override;
   std::vector<StateField> state_fields() override;
 
  protected:

@@ -126,6 +126,8 @@ class Stepper {
   // The scheme's velocity at the current time; for the Verlet family, which carries none,
   // the backward difference (r − r⁻)/Δt, the velocity half a step back.
   const Field<Vec3>& velocities() { return scheme_->velocities(); }
+  // The largest |v|² of velocities() over the owned nodes.
+  double max_speed2() { return scheme_->max_speed2(); }
 
   // The semi-implicit baseline's linear solves so far; nothing for the explicit schemes.
   std::optional<LinearSolveStats> linear_solves() const { return scheme_->linear_solves(); }
