@@ -163,7 +163,8 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   box_lo_.resize(cells);
   box_hi_.resize(cells);
   leeway_.assign(nodes, 0.5 * margin_);
-  cell_leeway_.resize(cells);
+  reach_lo_.resize(cells);
+  reach_hi_.resize(cells);
   needed_.assign(cells, 0);
   const int m = block.m, n = block.n;
   const int horizontal = (m - 1) * n;
@@ -476,13 +477,16 @@ void SelfContact::build_candidates(double extent_sum) {
     for (int a = 0; a < 3; ++a) move = std::max(move, std::abs(end_[p][a] - start_[p][a]));
     leeway_[p] = std::clamp(kLead * move, least, most);
   }
+  // Each cell's box grown by its leeway, once a build: the fill and every look-up read it.
   auto grown = [](const Vec3& x, double by) { return Vec3{x.x + by, x.y + by, x.z + by}; };
 #pragma omp parallel for schedule(static)
   for (std::size_t at = 0; at < present_cells_.size(); ++at) {
     const auto c = static_cast<std::size_t>(present_cells_[at]);
     const std::size_t n00 = c % cells_k + m * (c / cells_k);
-    cell_leeway_[c] =
+    const double leeway =
         std::max({leeway_[n00], leeway_[n00 + 1], leeway_[n00 + m], leeway_[n00 + m + 1]});
+    reach_lo_[c] = grown(box_lo_[c], -leeway);
+    reach_hi_[c] = grown(box_hi_[c], leeway);
   }
 
   bucket_start_.assign(buckets + 1, 0);
@@ -491,9 +495,7 @@ void SelfContact::build_candidates(double extent_sum) {
   for (int pass = 0; pass < 2; ++pass) {
     for (const std::int32_t cell : present_cells_) {
       const auto c = static_cast<std::size_t>(cell);
-      const double leeway = cell_leeway_[c];
-      if (range(grown(box_lo_[c], -leeway), grown(box_hi_[c], leeway), first, last) >
-          kMostBuckets) {
+      if (range(reach_lo_[c], reach_hi_[c], first, last) > kMostBuckets) {
         if (pass == 0) large_cells_.push_back(static_cast<std::int32_t>(c));
         continue;
       }
@@ -571,8 +573,7 @@ void SelfContact::build_candidates(double extent_sum) {
       std::size_t kept = 0;
       auto consider = [&](std::size_t c) {
         if (kept == candidates.size()) candidates.resize(2 * kept + 64);
-        const Vec3 clo = grown(box_lo_[c], -cell_leeway_[c]);
-        const Vec3 chi = grown(box_hi_[c], cell_leeway_[c]);
+        const Vec3 &clo = reach_lo_[c], &chi = reach_hi_[c];
         const bool meets = !(chi.x < lo.x) & !(clo.x > hi.x) & !(chi.y < lo.y) & !(clo.y > hi.y) &
                            !(chi.z < lo.z) & !(clo.z > hi.z);
         const bool other = (c != own[0]) & (c != own[1]) & (c != own[2]) & (c != own[3]);
@@ -638,8 +639,7 @@ void SelfContact::build_candidates(double extent_sum) {
     sides.clear();
     auto consider = [&](std::size_t c) {
       for (int a = 0; a < 3; ++a)
-        if (box_hi_[c][a] + cell_leeway_[c] < lo[a] || box_lo_[c][a] - cell_leeway_[c] > hi[a])
-          return;
+        if (reach_hi_[c][a] < lo[a] || reach_lo_[c][a] > hi[a]) return;
       const auto ck = static_cast<std::int32_t>(c % cells_k);
       const auto cl = static_cast<std::int32_t>(c / cells_k);
       const auto cell = static_cast<std::int32_t>(c);

@@ -181,11 +181,16 @@ void VerletFamily::set_velocities(const NodeVelocities& velocities) {
   velocities_current_ = false;
 }
 
+namespace {
+// The backward difference (r − r⁻)/Δt, the one formula of velocities() and max_speed2().
+Vec3 backward(const Vec3& r, const Vec3& rp, double dt) { return (r - rp) / dt; }
+}  // namespace
+
 const Field<Vec3>& VerletFamily::velocities() {
   if (!velocities_current_) {
     const double dt = dt_previous_;
     for_owned(context_.block, [&](int k, int l) {
-      velocity_report_(k, l) = (positions_(k, l) - previous_positions_(k, l)) / dt;
+      velocity_report_(k, l) = backward(positions_(k, l), previous_positions_(k, l), dt);
     });
     velocities_current_ = true;
   }
@@ -205,7 +210,7 @@ double VerletFamily::max_speed2() {
     const Vec3* rp = &previous_positions_(b.k0, l);
 #pragma omp simd reduction(max : most)
     for (int i = 0; i < b.owned_k(); ++i) {
-      const Vec3 v = (r[i] - rp[i]) / dt;
+      const Vec3 v = backward(r[i], rp[i], dt);
       most = std::max(most, dot(v, v));
     }
   }

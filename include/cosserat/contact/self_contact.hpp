@@ -52,9 +52,9 @@ class SelfContact {
   // About what one rank holds for an m x n grid: arrays over the whole grid for the state of
   // the step of the nodes it holds, six positions or velocities a node and, at most, 11 numbers
   // received for each (410 bytes with the candidate lists and the leeway), and each cell's box,
-  // leeway, four planes and eight buckets (380 bytes); the pairs come on top, a few per node in
-  // contact.
-  static double memory_bytes(int m, int n) { return 800.0 * m * n; }
+  // the box grown by its leeway, four planes and eight buckets (420 bytes); the pairs come on
+  // top, a few per node in contact.
+  static double memory_bytes(int m, int n) { return 830.0 * m * n; }
 
  private:
   // Two points of the grid held at the thickness apart along `normal`, each a weighted sum of
@@ -167,9 +167,10 @@ class SelfContact {
   std::vector<std::uint32_t> list_start_;
   std::vector<std::int32_t> list_cells_;
   std::vector<Vec3> built_;
-  // How far each node, and each cell's corners, may go from built_ in a coordinate before the
-  // lists are built again (find_pairs), m.
-  std::vector<double> leeway_, cell_leeway_;
+  // How far each node may go from built_ in a coordinate before the lists are built again
+  // (find_pairs), m; and each cell's box at the build grown by the largest of its corners'.
+  std::vector<double> leeway_;
+  std::vector<Vec3> reach_lo_, reach_hi_;
   double drift_ = 0.0;  // how much farther than its leeway a node has gone from built_, m
   // The cells in some node's list, in increasing order: those whose box and planes a step
   // needs.
