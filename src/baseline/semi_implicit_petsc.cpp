@@ -618,13 +618,21 @@ KrylovChoice default_linear_solver(bool exact_jacobian, long nodes, bool have_hy
 void add_petsc_options(const std::string& options) {
   start_petsc();
   check(PetscOptionsInsertString(nullptr, options.c_str()));
+  // PETSc reads -log_view as it starts, and it had started: without its log begun here,
+  // PetscFinalize refused to print the log, and the run, its output written, ended in an abort.
+  PetscBool log_view = PETSC_FALSE;
+  check(PetscOptionsHasName(nullptr, nullptr, "-log_view", &log_view));
+  if (log_view) check(PetscLogDefaultBegin());
 }
 
 void finalize_petsc() {
   if (!petsc_started_here) return;
   PetscBool finalized = PETSC_FALSE;
-  check(PetscFinalized(&finalized));
-  if (!finalized) check(PetscFinalize());
+  // After the run, whose output is written: a failure here is reported, not an abort.
+  if (PetscFinalized(&finalized) == 0 && finalized) return;
+  if (const PetscErrorCode code = PetscFinalize(); code != 0)
+    fmt::print(stderr, "warning: PETSc's finalisation failed (PETSc error {})\n",
+               static_cast<int>(code));
 }
 
 }  // namespace cosserat

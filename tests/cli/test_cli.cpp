@@ -979,6 +979,16 @@ TEST_F(Cli, UnknownSolverIsBadInput) {
   EXPECT_EQ(option.status, 2) << option.output;
   EXPECT_FALSE(fs::exists(path("p.h5")));
 }
+
+// PETSc's profile asked for by --petsc, after PETSc had started: printed at the end, and the
+// run ends as it would without it (it ended in an abort, status 134, its output written).
+TEST_F(Cli, PetscLogViewFromTheCommandLineIsPrinted) {
+  const std::string scene = write_scene("s.toml", kSmallScene);
+  const Result r = cosserat("run " + scene + " --set time.integrator=semi-implicit " +
+                            "--set time.steps=2 --petsc -log_view -o " + path("l.h5"));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_THAT(r.output, HasSubstr("KSPSolve"));
+}
 #endif
 
 }  // namespace
