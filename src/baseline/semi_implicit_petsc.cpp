@@ -616,13 +616,13 @@ KrylovChoice default_linear_solver(bool exact_jacobian, long nodes, bool have_hy
 }
 
 void add_petsc_options(const std::string& options) {
+  // Given before PETSc starts, as PETSC_OPTIONS is, so that it reads its start-up's own
+  // options (-log_view, -info, ...): given after, -log_view's log was never begun, and
+  // PetscFinalize's refusal to print it ended the run, its output written, in an abort. Given
+  // again once it has started, so that they stay on top of PETSC_OPTIONS.
+  check(PetscOptionsInsertString(nullptr, options.c_str()));
   start_petsc();
   check(PetscOptionsInsertString(nullptr, options.c_str()));
-  // PETSc reads -log_view as it starts, and it had started: without its log begun here,
-  // PetscFinalize refused to print the log, and the run, its output written, ended in an abort.
-  PetscBool log_view = PETSC_FALSE;
-  check(PetscOptionsHasName(nullptr, nullptr, "-log_view", &log_view));
-  if (log_view) check(PetscLogDefaultBegin());
 }
 
 void finalize_petsc() {
