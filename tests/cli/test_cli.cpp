@@ -980,8 +980,9 @@ TEST_F(Cli, UnknownSolverIsBadInput) {
   EXPECT_FALSE(fs::exists(path("p.h5")));
 }
 
-// PETSc's profile asked for by --petsc, after PETSc had started: printed at the end, and the
-// run ends as it would without it (it ended in an abort, status 134, its output written).
+// PETSc's profile asked for by --petsc: printed at the end, and the run ends as it would without
+// it. While --petsc's options reached PETSc only after it had started, the log was never begun
+// and the run ended in an abort (status 134), its output written.
 TEST_F(Cli, PetscLogViewFromTheCommandLineIsPrinted) {
   const std::string scene = write_scene("s.toml", kSmallScene);
   const Result r = cosserat("run " + scene + " --set time.integrator=semi-implicit " +
