@@ -54,6 +54,12 @@ constexpr double kSpare = 1.5;
 // A cell's box, in spacings of the hash, may cover up to this many buckets; larger cells (a
 // sheet tearing apart) are tested against every node.
 constexpr long kMostBuckets = 27;
+constexpr long kMostCellBuckets = 125;
+// A cell's six edges in the order SelfContact::build_candidates numbers them (its sides at l, at
+// l + 1, at k, at k + 1, its diagonals from (k, l) and from (k + 1, l)): each end's offsets in k
+// and l from the cell's first node.
+constexpr int kCellEdges[6][2][2] = {{{0, 0}, {1, 0}}, {{0, 1}, {1, 1}}, {{0, 0}, {0, 1}},
+                                     {{1, 0}, {1, 1}}, {{0, 0}, {1, 1}}, {{1, 0}, {0, 1}}};
 
 struct Foot {
   double a, b, c;
@@ -118,10 +124,12 @@ bool through(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const V
 
 }  // namespace
 
-SelfContact::SelfContact(double thickness, double friction, double spacing, const Block& block,
-                         const NodeMass& mass, const std::vector<SolidSpec>& solids)
+SelfContact::SelfContact(double thickness, double friction, bool every_edge, double spacing,
+                         const Block& block, const NodeMass& mass,
+                         const std::vector<SolidSpec>& solids)
     : thickness_(thickness),
       friction_(friction),
+      every_edge_(every_edge),
       margin_(kMargin * spacing),
       block_(&block),
       ranks_(size_of(block.comm)) {
@@ -137,6 +145,19 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
     send_offsets_.resize(static_cast<std::size_t>(ranks_));
     receive_counts_.resize(static_cast<std::size_t>(ranks_));
     receive_offsets_.resize(static_cast<std::size_t>(ranks_));
+  }
+  const int m = block.m, n = block.n;
+  const int horizontal = (m - 1) * n;
+  border_edge_.assign(static_cast<std::size_t>(horizontal + m * (n - 1)) +
+                          2 * static_cast<std::size_t>(m - 1) * static_cast<std::size_t>(n - 1),
+                      0);
+  for (int e = 0; e < horizontal; ++e) {
+    const int l = e / (m - 1);
+    if (l == 0 || l == n - 1) border_edge_[static_cast<std::size_t>(e)] = 1;
+  }
+  for (int e = 0; e < m * (n - 1); ++e) {
+    const int k = e % m;
+    if (k == 0 || k == m - 1) border_edge_[static_cast<std::size_t>(horizontal + e)] = 1;
   }
   present_.assign(nodes, ranks_ == 1 ? 1 : 0);
   if (ranks_ == 1) {
@@ -166,16 +187,8 @@ SelfContact::SelfContact(double thickness, double friction, double spacing, cons
   reach_lo_.resize(cells);
   reach_hi_.resize(cells);
   needed_.assign(cells, 0);
-  const int m = block.m, n = block.n;
-  const int horizontal = (m - 1) * n;
-  for (int e = 0; e < horizontal; ++e) {
-    const int l = e / (m - 1);
-    if (l == 0 || l == n - 1) border_edges_.push_back(e);
-  }
-  for (int e = 0; e < m * (n - 1); ++e) {
-    const int k = e % m;
-    if (k == 0 || k == m - 1) border_edges_.push_back(horizontal + e);
-  }
+  edge_lo_.resize(border_edge_.size());
+  edge_hi_.resize(border_edge_.size());
 }
 
 // A node on a fixed plane's offset surface or below it (the contact meets the planes before
@@ -374,6 +387,33 @@ void SelfContact::present_cells() {
         present_[i + m + 1] != 0)
       present_cells_.push_back(static_cast<std::int32_t>(k + (m - 1) * l));
   }
+  // The edges of those cells, in increasing number; those that meet others (every edge, or the
+  // border's), and the cells that hold them.
+  all_edges_.clear();
+  present_edges_.clear();
+  for (std::size_t e = 0; e < border_edge_.size(); ++e) {
+    const auto cells = edge_cells(static_cast<std::int32_t>(e));
+    if (!cell_present(cells[0]) && !cell_present(cells[1])) continue;
+    all_edges_.push_back(static_cast<std::int32_t>(e));
+    if (every_edge_ || border_edge_[e] != 0) present_edges_.push_back(static_cast<std::int32_t>(e));
+  }
+  edge_cells_.clear();
+  for (const std::int32_t c : present_cells_) {
+    bool holds = every_edge_;
+    const std::int32_t m1 = block_->m - 1, ck = c % m1, cl = c / m1;
+    holds = holds || ck == 0 || ck == m1 - 1 || cl == 0 || cl == block_->n - 2;
+    if (holds) edge_cells_.push_back(c);
+  }
+}
+
+// Whether this rank holds cell c's four corners (false for no cell, c < 0).
+bool SelfContact::cell_present(std::int32_t c) const {
+  if (c < 0) return false;
+  const std::int32_t m = block_->m;
+  const auto n00 = static_cast<std::size_t>(c % (m - 1) + m * (c / (m - 1)));
+  const auto mu = static_cast<std::size_t>(m);
+  return present_[n00] != 0 && present_[n00 + 1] != 0 && present_[n00 + mu] != 0 &&
+         present_[n00 + mu + 1] != 0;
 }
 
 // A node's velocity and inverse masses for the response: none for a held node; none across the
@@ -387,7 +427,7 @@ void SelfContact::motion(std::size_t i, const Vec3& velocity, bool held) {
   inverse_mass_[i] = held || on_floor(end_[i]) ? 0.0 : slide_inverse_mass_[i];
 }
 
-// Edge number e's two nodes, k + m l (SelfContact::border_edges_).
+// Edge number e's two nodes, k + m l (SelfContact::edge_candidates_).
 std::array<std::int32_t, 2> SelfContact::edge_nodes(std::int32_t e) const {
   const std::int32_t m = block_->m, n = block_->n, horizontal = (m - 1) * n;
   const std::int32_t sides = horizontal + m * (n - 1), cells = (m - 1) * (n - 1);
@@ -456,12 +496,13 @@ void SelfContact::build_candidates(double extent_sum) {
   std::size_t buckets = 1;
   while (buckets < 8 * held_cells) buckets *= 2;
   const std::uint64_t mask = buckets - 1;
-  auto range = [&](const Vec3& lo, const Vec3& hi, std::int64_t* first, std::int64_t* last) {
+  auto range = [&](const Vec3& lo, const Vec3& hi, std::int64_t* first, std::int64_t* last,
+                   long most) {
     long count = 1;
     for (int a = 0; a < 3; ++a) {
       first[a] = static_cast<std::int64_t>(std::floor(lo[a] * inverse));
       last[a] = static_cast<std::int64_t>(std::floor(hi[a] * inverse));
-      count *= static_cast<long>(std::min<std::int64_t>(last[a] - first[a] + 1, kMostBuckets + 1));
+      count *= static_cast<long>(std::min<std::int64_t>(last[a] - first[a] + 1, most + 1));
     }
     return count;
   };
@@ -495,7 +536,7 @@ void SelfContact::build_candidates(double extent_sum) {
   for (int pass = 0; pass < 2; ++pass) {
     for (const std::int32_t cell : present_cells_) {
       const auto c = static_cast<std::size_t>(cell);
-      if (range(reach_lo_[c], reach_hi_[c], first, last) > kMostBuckets) {
+      if (range(reach_lo_[c], reach_hi_[c], first, last, kMostBuckets) > kMostBuckets) {
         if (pass == 0) large_cells_.push_back(static_cast<std::int32_t>(c));
         continue;
       }
@@ -521,9 +562,9 @@ void SelfContact::build_candidates(double extent_sum) {
 
   // Calls consider(c) for every cell c in the buckets the box from lo to hi covers (some more
   // than once), or for every cell where it covers too many, and for every large cell.
-  auto each_cell_near = [&](const Vec3& lo, const Vec3& hi, auto&& consider) {
+  auto each_cell_near = [&](const Vec3& lo, const Vec3& hi, long most, auto&& consider) {
     std::int64_t from[3], to[3];
-    if (range(lo, hi, from, to) > kMostBuckets) {
+    if (range(lo, hi, from, to, most) > most) {
       for (const std::int32_t c : present_cells_) consider(static_cast<std::size_t>(c));
     } else {
       for (std::int64_t i = from[0]; i <= to[0]; ++i)
@@ -580,7 +621,7 @@ void SelfContact::build_candidates(double extent_sum) {
         candidates[kept] = static_cast<std::int32_t>(c);
         kept += static_cast<std::size_t>(meets & other);
       };
-      each_cell_near(lo, hi, consider);
+      each_cell_near(lo, hi, kMostBuckets, consider);
       const auto listed = candidates.begin() + static_cast<std::ptrdiff_t>(kept);
       std::sort(candidates.begin(), listed);
       const auto last = std::unique(candidates.begin(), listed);
@@ -599,71 +640,149 @@ void SelfContact::build_candidates(double extent_sum) {
   for (std::size_t c = 0; c < cells; ++c)
     if (listed_mark_[c] != 0) listed_.push_back(static_cast<std::int32_t>(c));
 
-  // Each border edge meets the edges of the cells its box, grown as a node's, finds in the
-  // hash, where those edges' own boxes, grown by their leeways, meet it and every node of one is
-  // more than two apart from every node of the other in k or l. Nearer edges are the fold of a cell
-  // or two, which the bending holds, and which a cloth hung from a corner makes there: held apart,
-  // the corner's edges and those two cells on fought the fold and threw a node
-  // (scenes/hard/denim_square.toml stopped at 2.35 s with them).
-  edge_candidates_.clear();
-  const auto mi = static_cast<std::int32_t>(m);
+  // Each cell's near cells: those whose boxes, grown by their leeways, come within the thickness
+  // of its own, grown by its leeway, and that are not next to it in the grid. Two edges come
+  // within the thickness only in such a pair of cells, and every edge of a cell next to another
+  // has a node within two of every edge of that one. One look-up a cell, on the rank's threads in
+  // static chunks, the chunks joined in thread order: the lists in cell order, the same for any
+  // count. A cell's box spans more buckets than a node's: up to kMostCellBuckets are visited
+  // before every cell is taken.
+  const std::int32_t mi = block_->m;
   const std::int32_t horizontal = (mi - 1) * block_->n;
   const std::int32_t diagonals = horizontal + mi * (block_->n - 1);
   const auto cells_i = static_cast<std::int32_t>(cells);
-  // An edge's box over the step grown by `grow` and its nodes' larger leeway.
-  auto edge_box = [&](std::int32_t edge, double grow, Vec3& lo, Vec3& hi) {
-    const auto nodes = edge_nodes(edge);
-    grow += std::max(leeway_[static_cast<std::size_t>(nodes[0])],
-                     leeway_[static_cast<std::size_t>(nodes[1])]);
-    lo = start_[static_cast<std::size_t>(nodes[0])];
-    hi = lo;
-    for (const std::int32_t node : nodes)
-      for (const Vec3& x :
-           {start_[static_cast<std::size_t>(node)], end_[static_cast<std::size_t>(node)]})
-        for (int a = 0; a < 3; ++a) {
-          lo[a] = std::min(lo[a], x[a] - grow);
-          hi[a] = std::max(hi[a], x[a] + grow);
-        }
-  };
-  auto is_border = [&](std::int32_t edge) {
-    return std::binary_search(border_edges_.begin(), border_edges_.end(), edge);
-  };
-  std::vector<std::int32_t>& sides = thread_candidates_[0];
-  for (const std::int32_t e : border_edges_) {
-    const auto mine = edge_nodes(e);
-    if (present_[static_cast<std::size_t>(mine[0])] == 0 ||
-        present_[static_cast<std::size_t>(mine[1])] == 0)
-      continue;
-    Vec3 lo, hi;
-    edge_box(e, thickness_, lo, hi);
-    sides.clear();
-    auto consider = [&](std::size_t c) {
-      for (int a = 0; a < 3; ++a)
-        if (reach_hi_[c][a] < lo[a] || reach_lo_[c][a] > hi[a]) return;
-      const auto ck = static_cast<std::int32_t>(c % cells_k);
-      const auto cl = static_cast<std::int32_t>(c / cells_k);
-      const auto cell = static_cast<std::int32_t>(c);
-      for (const std::int32_t f :
-           {ck + (mi - 1) * cl, ck + (mi - 1) * (cl + 1), horizontal + ck + mi * cl,
-            horizontal + ck + 1 + mi * cl, diagonals + cell, diagonals + cells_i + cell}) {
-        if (f <= e && is_border(f)) continue;
-        bool near = false;
-        for (const std::int32_t a : mine)
-          for (const std::int32_t b : edge_nodes(f))
-            near = near || (std::abs(a % mi - b % mi) <= 2 && std::abs(a / mi - b / mi) <= 2);
-        if (near) continue;
-        Vec3 flo, fhi;
-        edge_box(f, 0.0, flo, fhi);
-        bool apart = false;
-        for (int a = 0; a < 3; ++a) apart = apart || fhi[a] < lo[a] || flo[a] > hi[a];
-        if (!apart) sides.push_back(f);
-      }
-    };
-    each_cell_near(lo, hi, consider);
-    std::sort(sides.begin(), sides.end());
-    sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
-    for (const std::int32_t f : sides) edge_candidates_.push_back({e, f});
+  near_start_.assign(cells + 1, 0);
+  for (std::vector<std::int32_t>& found : thread_lists_) found.clear();
+#pragma omp parallel
+  {
+    const auto me = static_cast<std::size_t>(omp_get_thread_num());
+    std::vector<std::int32_t>& found = thread_lists_[me];
+    std::vector<std::int32_t>& candidates = thread_candidates_[me];
+#pragma omp for schedule(static)
+    for (std::size_t at = 0; at < edge_cells_.size(); ++at) {
+      const auto c = static_cast<std::size_t>(edge_cells_[at]);
+      const Vec3 lo = grown(reach_lo_[c], -thickness_), hi = grown(reach_hi_[c], thickness_);
+      const auto ck = static_cast<std::int64_t>(c % cells_k);
+      const auto cl = static_cast<std::int64_t>(c / cells_k);
+      std::size_t kept = 0;
+      auto consider = [&](std::size_t d) {
+        if (kept == candidates.size()) candidates.resize(2 * kept + 64);
+        const Vec3 &dlo = reach_lo_[d], &dhi = reach_hi_[d];
+        const bool meets = !(dhi.x < lo.x) & !(dlo.x > hi.x) & !(dhi.y < lo.y) & !(dlo.y > hi.y) &
+                           !(dhi.z < lo.z) & !(dlo.z > hi.z);
+        const auto dk = static_cast<std::int64_t>(d % cells_k);
+        const auto dl = static_cast<std::int64_t>(d / cells_k);
+        const bool apart = (std::abs(dk - ck) > 1) | (std::abs(dl - cl) > 1);
+        candidates[kept] = static_cast<std::int32_t>(d);
+        kept += static_cast<std::size_t>(meets & apart);
+      };
+      each_cell_near(lo, hi, kMostCellBuckets, consider);
+      const auto listed = candidates.begin() + static_cast<std::ptrdiff_t>(kept);
+      std::sort(candidates.begin(), listed);
+      const auto last = std::unique(candidates.begin(), listed);
+      found.insert(found.end(), candidates.begin(), last);
+      near_start_[c + 1] = static_cast<std::uint32_t>(last - candidates.begin());
+    }
   }
+  // Marked: the cells with near cells and the cells near them, whose edges are the only ones
+  // that can meet another edge.
+  near_mark_.assign(cells, 0);
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (near_start_[c + 1] != 0) near_mark_[c] = 1;
+    near_start_[c + 1] += near_start_[c];
+  }
+  near_cells_.clear();
+  for (const std::vector<std::int32_t>& found : thread_lists_)
+    near_cells_.insert(near_cells_.end(), found.begin(), found.end());
+  for (const std::int32_t c : near_cells_) near_mark_[static_cast<std::size_t>(c)] = 1;
+  auto has_near = [&](std::int32_t c) {
+    return c >= 0 &&
+           near_start_[static_cast<std::size_t>(c) + 1] != near_start_[static_cast<std::size_t>(c)];
+  };
+  auto marked = [&](std::int32_t c) { return c >= 0 && near_mark_[static_cast<std::size_t>(c)]; };
+
+  // Those edges' boxes over the step, grown by their nodes' larger leeway.
+#pragma omp parallel for schedule(static)
+  for (std::size_t at = 0; at < all_edges_.size(); ++at) {
+    const std::int32_t e = all_edges_[at];
+    const auto own = edge_cells(e);
+    if (!marked(own[0]) && !marked(own[1])) continue;
+    const auto nodes = edge_nodes(e);
+    const auto a = static_cast<std::size_t>(nodes[0]), b = static_cast<std::size_t>(nodes[1]);
+    const double grow = std::max(leeway_[a], leeway_[b]);
+    Vec3 lo, hi;
+    for (int x = 0; x < 3; ++x) {
+      lo[x] = std::min({start_[a][x], end_[a][x], start_[b][x], end_[b][x]}) - grow;
+      hi[x] = std::max({start_[a][x], end_[a][x], start_[b][x], end_[b][x]}) + grow;
+    }
+    edge_lo_[static_cast<std::size_t>(e)] = lo;
+    edge_hi_[static_cast<std::size_t>(e)] = hi;
+  }
+
+  // Each edge meets the edges of its cells' near cells where their boxes meet, one grown by the
+  // thickness too, and every node of one is more than two apart from every node of the other in
+  // k or l. Nearer edges are the fold of a cell or two, which the bending holds, and which a
+  // cloth hung from a corner makes there: held apart, the corner's edges and those two cells on
+  // fought the fold and threw a node (scenes/hard/denim_square.toml stopped at 2.35 s with them).
+  // Each pair once, the lower number first, in increasing order: on the rank's threads in static
+  // chunks of the edges, joined in thread order.
+  thread_edge_candidates_.resize(threads);
+  for (auto& found : thread_edge_candidates_) found.clear();
+#pragma omp parallel
+  {
+    const auto me = static_cast<std::size_t>(omp_get_thread_num());
+    std::vector<EdgeCandidate>& found = thread_edge_candidates_[me];
+    std::vector<std::int32_t>& sides = thread_candidates_[me];
+#pragma omp for schedule(static)
+    for (std::size_t at = 0; at < present_edges_.size(); ++at) {
+      const std::int32_t e = present_edges_[at];
+      const auto cells_e = edge_cells(e);
+      if (!has_near(cells_e[0]) && !has_near(cells_e[1])) continue;
+      const auto mine = edge_nodes(e);
+      const std::int32_t ak = mine[0] % mi, al = mine[0] / mi, bk = mine[1] % mi, bl = mine[1] / mi;
+      const Vec3 lo = grown(edge_lo_[static_cast<std::size_t>(e)], -thickness_);
+      const Vec3 hi = grown(edge_hi_[static_cast<std::size_t>(e)], thickness_);
+      sides.clear();
+      for (const std::int32_t own : cells_e) {
+        if (!has_near(own)) continue;
+        const auto o = static_cast<std::size_t>(own);
+        for (std::uint32_t at_near = near_start_[o]; at_near < near_start_[o + 1]; ++at_near) {
+          const std::int32_t cell = near_cells_[at_near];
+          const std::int32_t ck = cell % (mi - 1), cl = cell / (mi - 1);
+          // The cell's edges in the order of kCellEdges, each with its nodes' offsets.
+          const std::int32_t numbers[6] = {ck + (mi - 1) * cl,        ck + (mi - 1) * (cl + 1),
+                                           horizontal + ck + mi * cl, horizontal + ck + 1 + mi * cl,
+                                           diagonals + cell,          diagonals + cells_i + cell};
+          for (int j = 0; j < 6; ++j) {
+            const std::int32_t f = numbers[j];
+            // Every pair once: from the lower number's edge where both are listed.
+            if (f <= e && (every_edge_ || border_edge_[static_cast<std::size_t>(f)] != 0)) continue;
+            bool near = false;
+            for (int end = 0; end < 2; ++end) {
+              const std::int32_t fk = ck + kCellEdges[j][end][0], fl = cl + kCellEdges[j][end][1];
+              near = near || (std::abs(ak - fk) <= 2 && std::abs(al - fl) <= 2) ||
+                     (std::abs(bk - fk) <= 2 && std::abs(bl - fl) <= 2);
+            }
+            if (near) continue;
+            const Vec3 &flo = edge_lo_[static_cast<std::size_t>(f)],
+                       &fhi = edge_hi_[static_cast<std::size_t>(f)];
+            const bool meets = !(fhi.x < lo.x) & !(flo.x > hi.x) & !(fhi.y < lo.y) &
+                               !(flo.y > hi.y) & !(fhi.z < lo.z) & !(flo.z > hi.z);
+            if (meets) sides.push_back(f);
+          }
+        }
+      }
+      std::sort(sides.begin(), sides.end());
+      sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
+      for (const std::int32_t f : sides) {
+        const auto theirs = edge_nodes(f);
+        found.push_back({e, f, {mine[0], mine[1], theirs[0], theirs[1]}});
+      }
+    }
+  }
+  edge_candidates_.clear();
+  for (const auto& found : thread_edge_candidates_)
+    edge_candidates_.insert(edge_candidates_.end(), found.begin(), found.end());
 }
 
 // A cell's box over the step; its largest side.
@@ -877,11 +996,11 @@ void SelfContact::drop_covered(std::vector<Pair>& found, std::size_t first) {
   found.resize(kept);
 }
 
-// A border edge and another edge that cross over the step, or end it closer than the thickness,
-// are held the thickness apart along their common normal on the side they started on: where
-// the cloth's border slides past another part of the cloth, no node need meet a triangle, and
-// the edges would pass through each other between their nodes (docs/contact.md,
-// "Self-contact").
+// Two edges that cross over the step, or, where one is on the border, end it closer than the
+// thickness, are held the thickness apart along their common normal on the side they started
+// on: long edges crossed as the bars of an X, and a border sliding past another part of the
+// cloth, meet no node and no triangle, and would pass through each other between their nodes
+// (docs/contact.md, "Self-contact").
 void SelfContact::find_edge_pairs() {
   const double t = thickness_;
   const std::int32_t diagonals = (block_->m - 1) * block_->n + block_->m * (block_->n - 1);
@@ -898,55 +1017,78 @@ void SelfContact::find_edge_pairs() {
     u = (aa * e - ab * d) / denominator;
     return true;
   };
-  for (const auto& [e, f] : edge_candidates_) {
-    const auto ea = edge_nodes(e), eb = edge_nodes(f);
-    const auto a0 = static_cast<std::size_t>(ea[0]), a1 = static_cast<std::size_t>(ea[1]);
-    const auto b0 = static_cast<std::size_t>(eb[0]), b1 = static_cast<std::size_t>(eb[1]);
-    const Vec3 normal0 = cross(start_[a1] - start_[a0], start_[b1] - start_[b0]);
-    const Vec3 edge_a = end_[a1] - end_[a0], edge_b = end_[b1] - end_[b0];
-    const Vec3 normal1 = cross(edge_a, edge_b);
-    // Edges that turned through parallel in the step keep no side.
-    if (!(dot(normal0, normal1) > 0.0)) continue;
-    const double volume0 = dot(normal0, start_[a0] - start_[b0]);
-    const double volume1 = dot(normal1, end_[a0] - end_[b0]);
-    const double side = volume0 >= 0.0 ? 1.0 : -1.0;
-    const double length = norm(normal1);
-    const double d1 = side * volume1 / length;  // the lines' distance, on the starting side
-    if (d1 >= t) continue;
-    // The lines' nearest points at the step's end, which the pair holds apart.
-    double s, u;
-    if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u)) continue;
-    if (d1 < 0.0) {
-      // The lines met within the step (the volume passed through zero, linearly between its
-      // ends): where they met must lie within both edges, or within the thickness of them, or
-      // the edges passed beside each other.
-      const double at = volume0 / (volume0 - volume1);
-      const Vec3 p0 = lerp(start_[a0], end_[a0], at), q0 = lerp(start_[b0], end_[b0], at);
-      const Vec3 pa = lerp(start_[a1], end_[a1], at) - p0, qb = lerp(start_[b1], end_[b1], at) - q0;
-      double s_met, u_met;
-      if (!nearest(p0, pa, q0, qb, s_met, u_met)) continue;
-      const double slack_a = t / norm(pa), slack_b = t / norm(qb);
-      if (s_met < -slack_a || s_met > 1.0 + slack_a || u_met < -slack_b || u_met > 1.0 + slack_b)
+  // On the rank's threads in static chunks, the chunks' pairs joined in thread order: the pairs
+  // in the candidates' order, the same for any count.
+  for (std::vector<Pair>& found : thread_pairs_) found.clear();
+#pragma omp parallel
+  {
+    std::vector<Pair>& found = thread_pairs_[static_cast<std::size_t>(omp_get_thread_num())];
+#pragma omp for schedule(static)
+    for (std::size_t at = 0; at < edge_candidates_.size(); ++at) {
+      const EdgeCandidate& candidate = edge_candidates_[at];
+      const std::int32_t e = candidate.e, f = candidate.f;
+      const std::array<std::int32_t, 2> ea{candidate.nodes[0], candidate.nodes[1]};
+      const std::array<std::int32_t, 2> eb{candidate.nodes[2], candidate.nodes[3]};
+      const auto a0 = static_cast<std::size_t>(ea[0]), a1 = static_cast<std::size_t>(ea[1]);
+      const auto b0 = static_cast<std::size_t>(eb[0]), b1 = static_cast<std::size_t>(eb[1]);
+      const Vec3 normal0 = cross(start_[a1] - start_[a0], start_[b1] - start_[b0]);
+      const Vec3 edge_a = end_[a1] - end_[a0], edge_b = end_[b1] - end_[b0];
+      const Vec3 normal1 = cross(edge_a, edge_b);
+      // Edges that turned through parallel in the step keep no side.
+      if (!(dot(normal0, normal1) > 0.0)) continue;
+      const double volume0 = dot(normal0, start_[a0] - start_[b0]);
+      const double volume1 = dot(normal1, end_[a0] - end_[b0]);
+      const double side = volume0 >= 0.0 ? 1.0 : -1.0;
+      // Two edges inside the cloth are held only where they crossed: near, they lie in layers
+      // whose nodes the node pairs hold at t, and held there too they would push such layers
+      // twice (docs/contact.md, "Self-contact").
+      const bool inside = border_edge_[static_cast<std::size_t>(e)] == 0 &&
+                          border_edge_[static_cast<std::size_t>(f)] == 0;
+      if (inside && side * volume1 >= 0.0) continue;
+      const double length = norm(normal1);
+      const double d1 = side * volume1 / length;  // the lines' distance, on the starting side
+      if (d1 >= t) continue;
+      // The lines' nearest points at the step's end, which the pair holds apart.
+      double s, u;
+      if (!nearest(end_[a0], edge_a, end_[b0], edge_b, s, u)) continue;
+      if (d1 < 0.0) {
+        // The lines met within the step (the volume passed through zero, linearly between its
+        // ends): where they met must lie within both edges, or within the thickness of them, or
+        // the edges passed beside each other.
+        const double at = volume0 / (volume0 - volume1);
+        const Vec3 p0 = lerp(start_[a0], end_[a0], at), q0 = lerp(start_[b0], end_[b0], at);
+        const Vec3 pa = lerp(start_[a1], end_[a1], at) - p0,
+                   qb = lerp(start_[b1], end_[b1], at) - q0;
+        double s_met, u_met;
+        if (!nearest(p0, pa, q0, qb, s_met, u_met)) continue;
+        const double slack_a = t / norm(pa), slack_b = t / norm(qb);
+        if (s_met < -slack_a || s_met > 1.0 + slack_a || u_met < -slack_b || u_met > 1.0 + slack_b)
+          continue;
+      } else if (!(s > 0.0 && s < 1.0) || !(u > 0.0 && u < 1.0)) {
+        // Near where the lines are, but the edges' nearest points lie beyond an end: a node near
+        // an edge, which the node's pairs with the edge's triangles hold.
         continue;
-    } else if (!(s > 0.0 && s < 1.0) || !(u > 0.0 && u < 1.0)) {
-      // Near where the lines are, but the edges' nearest points lie beyond an end: a node near
-      // an edge, which the node's pairs with the edge's triangles hold.
-      continue;
+      }
+      // Edges that start the step with one through a cell of the other are tangled already (from
+      // before self-contact was on, a fix that drove them through, or passes that did not
+      // converge): held on the sides they start on, the tangle could never come undone.
+      const auto cells_a = edge_cells(e), cells_b = edge_cells(f);
+      if (through_cell(ea[0], ea[1], cells_b[0]) || through_cell(ea[0], ea[1], cells_b[1]) ||
+          through_cell(eb[0], eb[1], cells_a[0]) || through_cell(eb[0], eb[1], cells_a[1]))
+        continue;
+      s = std::clamp(s, 0.0, 1.0);
+      u = std::clamp(u, 0.0, 1.0);
+      // A diagonal is one of a cell's two, each at half weight as the triangles are.
+      const double share = (e >= diagonals ? 0.5 : 1.0) * (f >= diagonals ? 0.5 : 1.0);
+      found.push_back(Pair{{ea[0], ea[1], eb[0], eb[1]},
+                           {1.0 - s, s, -(1.0 - u), -u},
+                           side,
+                           share,
+                           normal1 / length});
     }
-    // Edges that start the step with one through a cell of the other are tangled already (from
-    // before self-contact was on, a fix that drove them through, or passes that did not
-    // converge): held on the sides they start on, the tangle could never come undone.
-    const auto cells_a = edge_cells(e), cells_b = edge_cells(f);
-    if (through_cell(ea[0], ea[1], cells_b[0]) || through_cell(ea[0], ea[1], cells_b[1]) ||
-        through_cell(eb[0], eb[1], cells_a[0]) || through_cell(eb[0], eb[1], cells_a[1]))
-      continue;
-    s = std::clamp(s, 0.0, 1.0);
-    u = std::clamp(u, 0.0, 1.0);
-    // A diagonal is one of a cell's two, each at half weight as the triangles are.
-    const double share = f >= diagonals ? 0.5 : 1.0;
-    pairs_.push_back(Pair{
-        {ea[0], ea[1], eb[0], eb[1]}, {1.0 - s, s, -(1.0 - u), -u}, side, share, normal1 / length});
   }
+  for (const std::vector<Pair>& found : thread_pairs_)
+    pairs_.insert(pairs_.end(), found.begin(), found.end());
 }
 
 // Σ w_i x_i over a pair's nodes is the first point's offset from the second, and Σ w_i² / m_i

@@ -972,9 +972,15 @@ void warn_if_folds_unresolved(const Origin& origin, Scene& scene) {
 // must be less than a grid spacing: a node is exempt only from the cells within two grid steps
 // of it, and the nearest others lie about two spacings away in a flat sheet.
 SelfContactSpec read_self_contact(const Table& table, const Scene& scene) {
-  table.allow({"friction"});
+  table.allow({"friction", "edges"});
   SelfContactSpec spec;
   if (const auto friction = table.find("friction")) spec.friction = non_negative(*friction);
+  if (const auto edges = table.find("edges")) {
+    const std::string name = edges->string();
+    if (name != "all" && name != "border")
+      edges->fail(fmt::format("unknown edges \"{}\"; allowed: all, border", name));
+    spec.every_edge = name == "all";
+  }
   spec.thickness = scene.material.thickness;
   if (spec.thickness == 0.0)
     table.fail(

@@ -191,10 +191,10 @@ Simulation::Simulation(const Scene& scene, MPI_Comm comm, const Decomposition& d
                    : std::make_unique<Contact>(scene.solids, block_, halo_, dynamics_.node_mass(),
                                                scene.gravity, std::min(scene.h1(), scene.h2()))),
       self_contact_(scene.self_contact
-                        ? std::make_unique<SelfContact>(scene.self_contact->thickness,
-                                                        scene.self_contact->friction,
-                                                        std::min(scene.h1(), scene.h2()), block_,
-                                                        dynamics_.node_mass(), scene.solids)
+                        ? std::make_unique<SelfContact>(
+                              scene.self_contact->thickness, scene.self_contact->friction,
+                              scene.self_contact->every_edge, std::min(scene.h1(), scene.h2()),
+                              block_, dynamics_.node_mass(), scene.solids)
                         : nullptr),
       stepper_(scene, decomposition_, block_, halo_, dynamics_, rest_positions(scene, block_),
                initial_velocities(scene, block_), make) {

@@ -172,6 +172,58 @@ TEST(SelfContact, ABorderEdgeDoesNotPassThroughAnother) {
   }
 }
 
+// The same X of two edges, both inside the cloth: edge B, (4, 1)–(5, 1) along z, drops at 40 m/s
+// through edge A, (0, 1)–(1, 1) along x, on a strip of 6 × 3 nodes. A's two cells hang below it,
+// one in the plane z = 0 and one leaning back to z = −0.2; B's stand above it, one in x = 0 and
+// one leaning out to x = 0.2; the cells between reach far away, so no node comes within 2 cm of a
+// triangle. Without self-contact, and with edges = "border" (the border's edges alone), B ends
+// 2 mm below A; with every edge (the default), B's middle ends at least the thickness above A's.
+TEST(SelfContact, TwoEdgesInsideTheClothDoNotPassThroughEachOther) {
+  const double thickness = 1e-3, dt = 1e-4;
+  const Vec3 drop{0.0, -40.0, 0.0};
+  const Vec3 at[6][3] = {{{-0.05, -0.1, 0.0}, {-0.05, 0.0, 0.0}, {-0.05, -0.1, -0.2}},
+                         {{0.05, -0.1, 0.0}, {0.05, 0.0, 0.0}, {0.05, -0.1, -0.2}},
+                         {{1.0, -0.1, 0.0}, {1.0, 0.0, 0.0}, {1.0, -0.1, -0.2}},
+                         {{1.0, 0.1, -0.5}, {1.0, 0.002, -0.5}, {1.2, 0.1, -0.5}},
+                         {{0.0, 0.1, -0.05}, {0.0, 0.002, -0.05}, {0.2, 0.1, -0.05}},
+                         {{0.0, 0.1, 0.05}, {0.0, 0.002, 0.05}, {0.2, 0.1, 0.05}}};
+  enum class Mode { off, border, every };
+  for (const Mode mode : {Mode::off, Mode::border, Mode::every}) {
+    Scene s = testing::flat_sheet(6, 3);
+    s.size1 = 0.5;
+    s.size2 = 0.2;
+    s.material.mass = 0.1;
+    s.material.zeta = {0.0, 0.0, 0.0};
+    s.material.xi = {0.0, 0.0, 0.0};
+    s.material.phi = {0.0, 0.0, 0.0};
+    s.material.thickness = thickness;
+    if (mode != Mode::off) s.self_contact = SelfContactSpec{thickness, 0.3, mode == Mode::every};
+    s.dt = dt;
+    Simulation sim(s, MPI_COMM_SELF);
+    Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
+    Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+    for (int k = 0; k < 6; ++k)
+      for (int l = 0; l < 3; ++l) {
+        r(k, l) = at[k][l];
+        before(k, l) = at[k][l] - (k >= 4 && l == 1 ? dt * drop : Vec3{});
+      }
+    sim.stepper().resume(0);
+    ASSERT_FALSE(sim.step());
+    const Field<Vec3>& x = sim.positions();
+    const double b_over_a = 0.5 * (x(4, 1).y + x(5, 1).y) - 0.5 * (x(0, 1).y + x(1, 1).y);
+    if (mode == Mode::every)
+      EXPECT_GE(b_over_a, 0.999 * thickness);
+    else
+      EXPECT_LT(b_over_a, -0.0019) << "the control must pass through";
+    // No node pair and no border edge pair: only the two edges inside could hold B.
+    if (mode == Mode::border) {
+      EXPECT_EQ(sim.self_contact_summary()->max_pairs, 0);
+    } else if (mode == Mode::every) {
+      EXPECT_EQ(sim.self_contact_summary()->max_pairs, 1);
+    }
+  }
+}
+
 // Σ m v over the run's nodes.
 Vec3 momentum(Simulation& sim) {
   const Block& b = sim.block();
@@ -359,6 +411,10 @@ TEST(SelfContactScene, ThePresetGivesTheThicknessAndTheSceneMayOverrideIt) {
       "t");
   EXPECT_DOUBLE_EQ(given.self_contact->thickness, 0.002);
   EXPECT_DOUBLE_EQ(given.self_contact->friction, 0.5);
+  EXPECT_TRUE(preset.self_contact->every_edge);
+  EXPECT_FALSE(
+      parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nedges = \"border\"\n"), "t")
+          .self_contact->every_edge);
   EXPECT_FALSE(parse_scene(scene_text("preset = \"denim\"", ""), "t").self_contact);
 }
 
@@ -374,6 +430,11 @@ TEST(SelfContactScene, AMissingOrBadThicknessIsRefused) {
       parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nfriction = -0.1\n"), "t"),
       SceneError);
   EXPECT_THROW(parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nmu = 0.1\n"), "t"),
+               SceneError);
+  EXPECT_THROW(
+      parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nedges = \"some\"\n"), "t"),
+      SceneError);
+  EXPECT_THROW(parse_scene(scene_text("preset = \"denim\"", "[self_contact]\nedges = 1\n"), "t"),
                SceneError);
 }
 

@@ -28,11 +28,12 @@ struct SelfContactStats {
 
 class SelfContact {
  public:
-  // `thickness` (m) and `friction` (μ between layers) from the scene's [self_contact] and
+  // `thickness` (m), `friction` (μ between layers) and `every_edge` (every edge against every
+  // other where they cross, else the border's edges alone) from the scene's [self_contact] and
   // material.thickness; `spacing` the smaller grid spacing (m); `solids` the scene's, whose
   // fixed planes support the layers on them.
-  SelfContact(double thickness, double friction, double spacing, const Block& block,
-              const NodeMass& mass, const std::vector<SolidSpec>& solids);
+  SelfContact(double thickness, double friction, bool every_edge, double spacing,
+              const Block& block, const NodeMass& mass, const std::vector<SolidSpec>& solids);
 
   // The step from `current` to `next` (owned nodes) of length dt, with `next_velocities` when
   // the scheme carries velocities, else (next − starts)/dt, or (next − current)/dt without
@@ -52,9 +53,10 @@ class SelfContact {
   // About what one rank holds for an m x n grid: arrays over the whole grid for the state of
   // the step of the nodes it holds, six positions or velocities a node and, at most, 11 numbers
   // received for each (410 bytes with the candidate lists and the leeway), and each cell's box,
-  // the box grown by its leeway, four planes and eight buckets (420 bytes); the pairs come on
-  // top, a few per node in contact.
-  static double memory_bytes(int m, int n) { return 830.0 * m * n; }
+  // the box grown by its leeway, four planes and eight buckets (420 bytes), and each of the four
+  // edges a node has about, its box and marks (240 bytes); the pairs come on top, a few per node
+  // in contact.
+  static double memory_bytes(int m, int n) { return 1070.0 * m * n; }
 
  private:
   // Two points of the grid held at the thickness apart along `normal`, each a weighted sum of
@@ -83,6 +85,7 @@ class SelfContact {
               const Field<Vec3>* next_velocities, const Field<Vec3>* starts, double dt,
               const std::vector<char>& held);
   void present_cells();
+  bool cell_present(std::int32_t c) const;
   void motion(std::size_t i, const Vec3& velocity, bool held);
   bool on_floor(const Vec3& x) const;
   double cell_box(std::size_t c);
@@ -109,6 +112,7 @@ class SelfContact {
 
   double thickness_;
   double friction_;
+  bool every_edge_;  // every edge meets others where they cross; else the border's alone
   double margin_;  // m: how far the candidate lists look beyond the thickness
   std::vector<Floor> floors_;
   const Block* block_;
@@ -177,17 +181,33 @@ class SelfContact {
   std::vector<std::int32_t> listed_;
   std::vector<char> listed_mark_;
 
-  // The cloth's border edges, whose crossings no node meets, against every edge of the grid:
-  // edges are numbered (k, l)–(k + 1, l) as k + (m − 1) l, then (k, l)–(k, l + 1) as
-  // (m − 1) n + k + m l, then each cell c's diagonals from (k, l) and from (k + 1, l), after
-  // those, as c and (m − 1)(n − 1) + c. The border edges in increasing number, and the pairs of a
-  // border edge and another edge, nodes more than two apart, whose boxes met at the last build (a
-  // pair of border edges once, the lower number first).
+  // Edges against edges, whose crossings no node meets: edges are numbered (k, l)–(k + 1, l) as
+  // k + (m − 1) l, then (k, l)–(k, l + 1) as (m − 1) n + k + m l, then each cell c's diagonals
+  // from (k, l) and from (k + 1, l), after those, as c and (m − 1)(n − 1) + c. The candidates are
+  // the pairs of edges, nodes more than two apart, whose boxes met at the last build (each pair
+  // once, the lower number first where both are listed); those of two edges inside the cloth
+  // are held only where they cross (find_edge_pairs).
   std::array<std::int32_t, 2> edge_nodes(std::int32_t edge) const;
   std::array<std::int32_t, 2> edge_cells(std::int32_t edge) const;
   bool through_cell(std::int32_t p, std::int32_t q, std::int32_t cell) const;
-  std::vector<std::int32_t> border_edges_;
-  std::vector<std::array<std::int32_t, 2>> edge_candidates_;
+  std::vector<char> border_edge_;  // over every edge: 1 on the cloth's border
+  // The edges of the cells held that meet others (every edge, or the border's: every_edge_), in
+  // increasing number.
+  std::vector<std::int32_t> present_edges_;
+  // Each held cell's near cells (near_cells_ from near_start_[c] to near_start_[c + 1]), found
+  // at the build: those whose boxes come within the thickness of its own, not next to it.
+  std::vector<std::uint32_t> near_start_;
+  std::vector<std::int32_t> near_cells_;
+  std::vector<char> near_mark_;           // a cell with near cells, or near another's
+  std::vector<std::int32_t> all_edges_;   // every edge of a cell held, in increasing number
+  std::vector<std::int32_t> edge_cells_;  // the held cells that hold an edge of present_edges_
+  std::vector<Vec3> edge_lo_, edge_hi_;   // an edge's box over the step at the build (grown)
+  struct EdgeCandidate {
+    std::int32_t e, f;
+    std::int32_t nodes[4];  // e's two, then f's
+  };
+  std::vector<EdgeCandidate> edge_candidates_;
+  std::vector<std::vector<EdgeCandidate>> thread_edge_candidates_;
 };
 
 }  // namespace cosserat

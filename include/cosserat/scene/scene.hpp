@@ -119,6 +119,7 @@ struct LinearSolver {
 struct SelfContactSpec {
   double thickness = 0.0;  // m: material.thickness, or its preset's
   double friction = 0.3;   // Coulomb's μ between the layers
+  bool every_edge = true;  // edges = "all": every edge against every other; "border": the border's
 };
 
 // The per-node fields a run can write beside its positions (docs/output.md, "Fields"), in the
