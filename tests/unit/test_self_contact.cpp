@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -126,102 +127,88 @@ TEST_F(PressedLayers, ANodeOverANodeOfTheLayerBelowIsPushedAlongTheNormal) {
   EXPECT_LT(most, 1e-12) << "a node of the bottom layer moved along it";
 }
 
-// Two border edges crossed like the bars of an X, 4 mm apart in a step where the thickness is
-// 1 mm: edge B, (4, 1)–(5, 1) along z, drops at 40 m/s through edge A, (0, 0)–(1, 0) along x.
-// A strip of 6 × 2 nodes with no stiffness holds them: A's cell hangs below it in the plane
-// z = 0, B's stands above it in x = 0, and the cells between reach far away, so no node comes
-// within 5 cm of a triangle and only the edges meet. Without self-contact B ends 2 mm below
-// A; with it, B's middle ends at least the thickness above A's (the crossing found from the
-// lines' signed volume; before border edges met other edges B went through, checked).
-TEST(SelfContact, ABorderEdgeDoesNotPassThroughAnother) {
-  const double thickness = 1e-3, dt = 1e-4;
+// One step of a strip of 6 × n nodes with no stiffness, 0.5 m by `width`, from the nodes `at`
+// (at[k][l]) at rest but for edge B, (4, b)–(5, b), which drops at 40 m/s, 4 mm in the step;
+// `self_contact` none, or its rule. Returns how far B's middle ends above edge A's, (0, a)–(1, a),
+// and the most pairs held in the step.
+struct Crossing {
+  double b_over_a;
+  long pairs;
+};
+Crossing drop_through(const std::vector<std::vector<Vec3>>& at, int a, int b, double thickness,
+                      std::optional<SelfContactSpec> self_contact) {
+  const double dt = 1e-4;
   const Vec3 drop{0.0, -40.0, 0.0};
-  const Vec3 at[6][2] = {{{-0.05, 0.0, 0.0}, {-0.05, -0.1, 0.0}},
-                         {{0.05, 0.0, 0.0}, {0.05, -0.1, 0.0}},
-                         {{1.0, 0.0, 0.0}, {1.0, -0.1, 0.0}},
-                         {{1.0, 0.1, -0.5}, {1.0, 0.002, -0.5}},
-                         {{0.0, 0.1, -0.05}, {0.0, 0.002, -0.05}},
-                         {{0.0, 0.1, 0.05}, {0.0, 0.002, 0.05}}};
-  for (const bool on : {false, true}) {
-    Scene s = testing::flat_sheet(6, 2);
-    s.size1 = 0.5;
-    s.size2 = 0.1;
-    s.material.mass = 0.1;
-    s.material.zeta = {0.0, 0.0, 0.0};
-    s.material.xi = {0.0, 0.0, 0.0};
-    s.material.phi = {0.0, 0.0, 0.0};
-    s.material.thickness = thickness;
-    if (on) s.self_contact = SelfContactSpec{thickness, 0.3};
-    s.dt = dt;
-    Simulation sim(s, MPI_COMM_SELF);
-    Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
-    Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
-    for (int k = 0; k < 6; ++k)
-      for (int l = 0; l < 2; ++l) {
-        r(k, l) = at[k][l];
-        before(k, l) = at[k][l] - (k >= 4 && l == 1 ? dt * drop : Vec3{});
-      }
-    sim.stepper().resume(0);
-    ASSERT_FALSE(sim.step());
-    const Field<Vec3>& x = sim.positions();
-    const double b_over_a = 0.5 * (x(4, 1).y + x(5, 1).y) - 0.5 * (x(0, 0).y + x(1, 0).y);
-    if (on)
-      EXPECT_GE(b_over_a, 0.999 * thickness);
-    else
-      EXPECT_LT(b_over_a, -0.0019) << "the control must pass through";
-  }
+  const int n = static_cast<int>(at[0].size());
+  Scene s = testing::flat_sheet(6, n);
+  s.size1 = 0.5;
+  s.size2 = 0.1 * (n - 1);
+  s.material.mass = 0.1;
+  s.material.zeta = {0.0, 0.0, 0.0};
+  s.material.xi = {0.0, 0.0, 0.0};
+  s.material.phi = {0.0, 0.0, 0.0};
+  s.material.thickness = thickness;
+  s.self_contact = self_contact;
+  s.dt = dt;
+  Simulation sim(s, MPI_COMM_SELF);
+  Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
+  Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
+  for (int k = 0; k < 6; ++k)
+    for (int l = 0; l < n; ++l) {
+      r(k, l) = at[static_cast<std::size_t>(k)][static_cast<std::size_t>(l)];
+      before(k, l) = r(k, l) - (k >= 4 && l == b ? dt * drop : Vec3{});
+    }
+  sim.stepper().resume(0);
+  EXPECT_FALSE(sim.step());
+  const Field<Vec3>& x = sim.positions();
+  return {0.5 * (x(4, b).y + x(5, b).y) - 0.5 * (x(0, a).y + x(1, a).y),
+          self_contact ? sim.self_contact_summary()->max_pairs : 0};
 }
 
-// The same X of two edges, both inside the cloth: edge B, (4, 1)–(5, 1) along z, drops at 40 m/s
-// through edge A, (0, 1)–(1, 1) along x, on a strip of 6 × 3 nodes. A's two cells hang below it,
-// one in the plane z = 0 and one leaning back to z = −0.2; B's stand above it, one in x = 0 and
-// one leaning out to x = 0.2; the cells between reach far away, so no node comes within 2 cm of a
-// triangle. Without self-contact, and with edges = "border" (the border's edges alone), B ends
-// 2 mm below A; with every edge (the default), B's middle ends at least the thickness above A's.
+// Two border edges crossed like the bars of an X, 4 mm apart in a step where the thickness is
+// 1 mm: edge B, (4, 1)–(5, 1) along z, drops at 40 m/s through edge A, (0, 0)–(1, 0) along x.
+// A strip of 6 × 2 nodes holds them: A's cell hangs below it in the plane z = 0, B's stands above
+// it in x = 0, and the cells between reach far away, so no node comes within 5 cm of a triangle
+// and only the edges meet. Without self-contact B ends 2 mm below A; with it, B's middle ends at
+// least the thickness above A's (the crossing found from the lines' signed volume; before border
+// edges met other edges B went through, checked).
+TEST(SelfContact, ABorderEdgeDoesNotPassThroughAnother) {
+  const double thickness = 1e-3;
+  const std::vector<std::vector<Vec3>> at = {
+      {{-0.05, 0.0, 0.0}, {-0.05, -0.1, 0.0}},  {{0.05, 0.0, 0.0}, {0.05, -0.1, 0.0}},
+      {{1.0, 0.0, 0.0}, {1.0, -0.1, 0.0}},      {{1.0, 0.1, -0.5}, {1.0, 0.002, -0.5}},
+      {{0.0, 0.1, -0.05}, {0.0, 0.002, -0.05}}, {{0.0, 0.1, 0.05}, {0.0, 0.002, 0.05}}};
+  EXPECT_LT(drop_through(at, 0, 1, thickness, std::nullopt).b_over_a, -0.0019)
+      << "the control must pass through";
+  for (const bool every : {false, true})
+    EXPECT_GE(drop_through(at, 0, 1, thickness, SelfContactSpec{thickness, 0.3, every}).b_over_a,
+              0.999 * thickness);
+}
+
+// The same X of two edges, both inside the cloth: edge B, (4, 1)–(5, 1) along z, drops through
+// edge A, (0, 1)–(1, 1) along x, on a strip of 6 × 3 nodes. A's two cells hang below it, one in
+// the plane z = 0 and one leaning back to z = −0.2; B's stand above it, one in x = 0 and one
+// leaning out to x = 0.2; the cells between reach far away, so no node comes within 2 cm of a
+// triangle and no pair but the two edges' is held. Without self-contact, and with edges =
+// "border" (the border's edges alone), B ends 2 mm below A; with every edge (the default), B's
+// middle ends at least the thickness above A's.
 TEST(SelfContact, TwoEdgesInsideTheClothDoNotPassThroughEachOther) {
-  const double thickness = 1e-3, dt = 1e-4;
-  const Vec3 drop{0.0, -40.0, 0.0};
-  const Vec3 at[6][3] = {{{-0.05, -0.1, 0.0}, {-0.05, 0.0, 0.0}, {-0.05, -0.1, -0.2}},
-                         {{0.05, -0.1, 0.0}, {0.05, 0.0, 0.0}, {0.05, -0.1, -0.2}},
-                         {{1.0, -0.1, 0.0}, {1.0, 0.0, 0.0}, {1.0, -0.1, -0.2}},
-                         {{1.0, 0.1, -0.5}, {1.0, 0.002, -0.5}, {1.2, 0.1, -0.5}},
-                         {{0.0, 0.1, -0.05}, {0.0, 0.002, -0.05}, {0.2, 0.1, -0.05}},
-                         {{0.0, 0.1, 0.05}, {0.0, 0.002, 0.05}, {0.2, 0.1, 0.05}}};
-  enum class Mode { off, border, every };
-  for (const Mode mode : {Mode::off, Mode::border, Mode::every}) {
-    Scene s = testing::flat_sheet(6, 3);
-    s.size1 = 0.5;
-    s.size2 = 0.2;
-    s.material.mass = 0.1;
-    s.material.zeta = {0.0, 0.0, 0.0};
-    s.material.xi = {0.0, 0.0, 0.0};
-    s.material.phi = {0.0, 0.0, 0.0};
-    s.material.thickness = thickness;
-    if (mode != Mode::off) s.self_contact = SelfContactSpec{thickness, 0.3, mode == Mode::every};
-    s.dt = dt;
-    Simulation sim(s, MPI_COMM_SELF);
-    Field<Vec3>& r = *sim.stepper().state_fields().at(0).field;
-    Field<Vec3>& before = *sim.stepper().state_fields().at(1).field;  // the Verlet step's r⁻
-    for (int k = 0; k < 6; ++k)
-      for (int l = 0; l < 3; ++l) {
-        r(k, l) = at[k][l];
-        before(k, l) = at[k][l] - (k >= 4 && l == 1 ? dt * drop : Vec3{});
-      }
-    sim.stepper().resume(0);
-    ASSERT_FALSE(sim.step());
-    const Field<Vec3>& x = sim.positions();
-    const double b_over_a = 0.5 * (x(4, 1).y + x(5, 1).y) - 0.5 * (x(0, 1).y + x(1, 1).y);
-    if (mode == Mode::every)
-      EXPECT_GE(b_over_a, 0.999 * thickness);
-    else
-      EXPECT_LT(b_over_a, -0.0019) << "the control must pass through";
-    // No node pair and no border edge pair: only the two edges inside could hold B.
-    if (mode == Mode::border) {
-      EXPECT_EQ(sim.self_contact_summary()->max_pairs, 0);
-    } else if (mode == Mode::every) {
-      EXPECT_EQ(sim.self_contact_summary()->max_pairs, 1);
-    }
-  }
+  const double thickness = 1e-3;
+  const std::vector<std::vector<Vec3>> at = {
+      {{-0.05, -0.1, 0.0}, {-0.05, 0.0, 0.0}, {-0.05, -0.1, -0.2}},
+      {{0.05, -0.1, 0.0}, {0.05, 0.0, 0.0}, {0.05, -0.1, -0.2}},
+      {{1.0, -0.1, 0.0}, {1.0, 0.0, 0.0}, {1.0, -0.1, -0.2}},
+      {{1.0, 0.1, -0.5}, {1.0, 0.002, -0.5}, {1.2, 0.1, -0.5}},
+      {{0.0, 0.1, -0.05}, {0.0, 0.002, -0.05}, {0.2, 0.1, -0.05}},
+      {{0.0, 0.1, 0.05}, {0.0, 0.002, 0.05}, {0.2, 0.1, 0.05}}};
+  EXPECT_LT(drop_through(at, 1, 1, thickness, std::nullopt).b_over_a, -0.0019)
+      << "the control must pass through";
+  const Crossing border = drop_through(at, 1, 1, thickness, SelfContactSpec{thickness, 0.3, false});
+  EXPECT_LT(border.b_over_a, -0.0019) << "with the border's edges alone B must pass through";
+  EXPECT_EQ(border.pairs, 0);
+  const Crossing every = drop_through(at, 1, 1, thickness, SelfContactSpec{thickness, 0.3, true});
+  EXPECT_GE(every.b_over_a, 0.999 * thickness);
+  EXPECT_EQ(every.pairs, 1);
 }
 
 // Σ m v over the run's nodes.
