@@ -54,6 +54,9 @@ constexpr double kSpare = 1.5;
 // A cell's box, in spacings of the hash, may cover up to this many buckets; larger cells (a
 // sheet tearing apart) are tested against every node.
 constexpr long kMostBuckets = 27;
+// A cell's own look-up (build_candidates, for the pairs of edges) is its box grown by its leeway
+// and the thickness, up to about three mean cell extents a side where a corner moves fast, so
+// four or five buckets of the hash a side: up to this many before every cell is taken.
 constexpr long kMostCellBuckets = 125;
 // A cell's six edges in the order SelfContact::build_candidates numbers them (its sides at l, at
 // l + 1, at k, at k + 1, its diagonals from (k, l) and from (k + 1, l)): each end's offsets in k
