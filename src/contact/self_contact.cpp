@@ -397,22 +397,20 @@ void SelfContact::present_cells() {
         present_[i + m + 1] != 0)
       present_cells_.push_back(static_cast<std::int32_t>(k + (m - 1) * l));
   }
-  // The edges of those cells, in increasing number; those that meet others (every edge, or the
-  // border's), and the cells that hold them.
-  all_edges_.clear();
+  // The edges of those cells that meet others (every edge, or the border's), in increasing
+  // number; with the border's alone, the cells that hold them (else every cell held does).
   present_edges_.clear();
   for (std::size_t e = 0; e < border_edge_.size(); ++e) {
     const auto cells = edge_cells(static_cast<std::int32_t>(e));
-    if (!cell_present(cells[0]) && !cell_present(cells[1])) continue;
-    all_edges_.push_back(static_cast<std::int32_t>(e));
-    if (every_edge_ || border_edge_[e] != 0) present_edges_.push_back(static_cast<std::int32_t>(e));
+    if ((every_edge_ || border_edge_[e] != 0) && (cell_present(cells[0]) || cell_present(cells[1])))
+      present_edges_.push_back(static_cast<std::int32_t>(e));
   }
-  edge_cells_.clear();
+  border_cells_.clear();
+  if (every_edge_) return;
+  const std::int32_t m1 = block_->m - 1;
   for (const std::int32_t c : present_cells_) {
-    bool holds = every_edge_;
-    const std::int32_t m1 = block_->m - 1, ck = c % m1, cl = c / m1;
-    holds = holds || ck == 0 || ck == m1 - 1 || cl == 0 || cl == block_->n - 2;
-    if (holds) edge_cells_.push_back(c);
+    const std::int32_t ck = c % m1, cl = c / m1;
+    if (ck == 0 || ck == m1 - 1 || cl == 0 || cl == block_->n - 2) border_cells_.push_back(c);
   }
 }
 
@@ -667,6 +665,7 @@ void SelfContact::build_candidates(double extent_sum) {
   const std::int32_t diagonals = horizontal + mi * (block_->n - 1);
   const auto cells_i = static_cast<std::int32_t>(cells);
   near_start_.assign(cells + 1, 0);
+  const std::vector<std::int32_t>& looked_up = every_edge_ ? present_cells_ : border_cells_;
   for (std::vector<std::int32_t>& found : thread_lists_) found.clear();
 #pragma omp parallel
   {
@@ -674,8 +673,8 @@ void SelfContact::build_candidates(double extent_sum) {
     std::vector<std::int32_t>& found = thread_lists_[me];
     std::vector<std::int32_t>& candidates = thread_candidates_[me];
 #pragma omp for schedule(static)
-    for (std::size_t at = 0; at < edge_cells_.size(); ++at) {
-      const auto c = static_cast<std::size_t>(edge_cells_[at]);
+    for (std::size_t at = 0; at < looked_up.size(); ++at) {
+      const auto c = static_cast<std::size_t>(looked_up[at]);
       const Vec3 lo = grown(reach_lo_[c], -thickness_), hi = grown(reach_hi_[c], thickness_);
       const auto ck = static_cast<std::int64_t>(c % cells_k);
       const auto cl = static_cast<std::int64_t>(c / cells_k);
@@ -704,10 +703,10 @@ void SelfContact::build_candidates(double extent_sum) {
   };
   auto marked = [&](std::int32_t c) { return c >= 0 && near_mark_[static_cast<std::size_t>(c)]; };
 
-  // Those edges' boxes over the step, grown by their nodes' larger leeway.
+  // Those edges' boxes over the step, grown by their nodes' larger leeway (a marked cell is held).
+  const auto edges = static_cast<std::int32_t>(border_edge_.size());
 #pragma omp parallel for schedule(static)
-  for (std::size_t at = 0; at < all_edges_.size(); ++at) {
-    const std::int32_t e = all_edges_[at];
+  for (std::int32_t e = 0; e < edges; ++e) {
     const auto own = edge_cells(e);
     if (!marked(own[0]) && !marked(own[1])) continue;
     const auto nodes = edge_nodes(e);
@@ -776,7 +775,9 @@ void SelfContact::build_candidates(double extent_sum) {
       sides.erase(std::unique(sides.begin(), sides.end()), sides.end());
       for (const std::int32_t f : sides) {
         const auto theirs = edge_nodes(f);
-        found.push_back({e, f, {mine[0], mine[1], theirs[0], theirs[1]}});
+        const bool inside = border_edge_[static_cast<std::size_t>(e)] == 0 &&
+                            border_edge_[static_cast<std::size_t>(f)] == 0;
+        found.push_back({e, f, {mine[0], mine[1], theirs[0], theirs[1]}, inside});
       }
     }
   }
@@ -1042,9 +1043,7 @@ void SelfContact::find_edge_pairs() {
       // Two edges inside the cloth are held only where they crossed: near, they lie in layers
       // whose nodes the node pairs hold at t, and held there too they would push such layers
       // twice (docs/contact.md, "Self-contact").
-      const bool inside = border_edge_[static_cast<std::size_t>(e)] == 0 &&
-                          border_edge_[static_cast<std::size_t>(f)] == 0;
-      if (inside && side * volume1 >= 0.0) continue;
+      if (candidate.inside && side * volume1 >= 0.0) continue;
       const double length = norm(normal1);
       const double d1 = side * volume1 / length;  // the lines' distance, on the starting side
       if (d1 >= t) continue;

@@ -199,12 +199,12 @@ class SelfContact {
   std::vector<std::uint32_t> near_start_;
   std::vector<std::int32_t> near_cells_;
   std::vector<char> near_mark_;           // a cell with near cells, or near another's
-  std::vector<std::int32_t> all_edges_;   // every edge of a cell held, in increasing number
-  std::vector<std::int32_t> edge_cells_;  // the held cells that hold an edge of present_edges_
+  std::vector<std::int32_t> border_cells_;  // with the border's edges alone: the cells they bound
   std::vector<Vec3> edge_lo_, edge_hi_;   // an edge's box over the step at the build (grown)
   struct EdgeCandidate {
     std::int32_t e, f;
     std::int32_t nodes[4];  // e's two, then f's
+    bool inside;            // neither on the border: held only where they cross
   };
   std::vector<EdgeCandidate> edge_candidates_;
   std::vector<std::vector<EdgeCandidate>> thread_edge_candidates_;
