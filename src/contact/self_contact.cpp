@@ -729,10 +729,10 @@ void SelfContact::build_candidates(double extent_sum) {
   // An edge's own cell is the first of its two this rank holds. Its box holds the edge's, so two
   // edges whose boxes meet have own cells that are near each other, or next to each other in the
   // grid, where every node of one is within two of every node of the other: each pair is found
-  // from the first edge's own cell and the second's, once. (From both cells of each edge and all
-  // six edges of their near cells, the same pairs took 1.7 times as long to list on S6 x 5.) The
-  // lower number's edge takes the pair, in increasing order, on the rank's threads in static
-  // chunks of the edges, joined in thread order.
+  // once, from the first edge's own cell and the second's. (From both cells of each edge and all
+  // six edges of their near cells, most pairs were found two to four times.) The lower number's
+  // edge takes the pair, in increasing order, on the rank's threads in static chunks of the
+  // edges, joined in thread order.
   auto own_cell = [&](std::int32_t e) {
     const auto two = edge_cells(e);
     return cell_present(two[0]) ? two[0] : two[1];
@@ -758,27 +758,14 @@ void SelfContact::build_candidates(double extent_sum) {
       for (std::uint32_t at_near = near_start_[o]; at_near < near_start_[o + 1]; ++at_near) {
         const std::int32_t cell = near_cells_[at_near];
         const std::int32_t ck = cell % (mi - 1), cl = cell / (mi - 1);
-        // The cell's edges in the order of kCellEdges, each with its nodes' offsets; its bottom
-        // and left sides are its own only where the rank holds no cell below or left of it.
+        // The cell's edges in the order of kCellEdges, each with its nodes' offsets.
         const std::int32_t numbers[6] = {ck + (mi - 1) * cl,        ck + (mi - 1) * (cl + 1),
                                          horizontal + ck + mi * cl, horizontal + ck + 1 + mi * cl,
                                          diagonals + cell,          diagonals + cells_i + cell};
-        const std::int32_t n00 = ck + mi * cl;
-        auto held = [&](std::int32_t node) {
-          return present_[static_cast<std::size_t>(node)] != 0;
-        };
-        const bool owns[6] = {!(cl > 0 && held(n00 - mi) && held(n00 - mi + 1)),
-                              true,
-                              !(ck > 0 && held(n00 - 1) && held(n00 + mi - 1)),
-                              true,
-                              true,
-                              true};
         for (int j = 0; j < 6; ++j) {
           const std::int32_t f = numbers[j];
           // Every pair once: from the lower number's edge where both are listed.
-          if (!owns[j] ||
-              (f <= e && (every_edge_ || border_edge_[static_cast<std::size_t>(f)] != 0)))
-            continue;
+          if (f <= e && (every_edge_ || border_edge_[static_cast<std::size_t>(f)] != 0)) continue;
           bool near = false;
           for (int end = 0; end < 2; ++end) {
             const std::int32_t fk = ck + kCellEdges[j][end][0], fl = cl + kCellEdges[j][end][1];
@@ -787,7 +774,8 @@ void SelfContact::build_candidates(double extent_sum) {
           }
           if (near) continue;
           const auto fi = static_cast<std::size_t>(f);
-          if (boxes_meet(lo, hi, edge_lo_[fi], edge_hi_[fi])) sides.push_back(f);
+          if (boxes_meet(lo, hi, edge_lo_[fi], edge_hi_[fi]) && own_cell(f) == cell)
+            sides.push_back(f);
         }
       }
       std::sort(sides.begin(), sides.end());
