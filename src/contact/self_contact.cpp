@@ -58,7 +58,7 @@ constexpr long kMostBuckets = 27;
 // and the thickness, up to about three mean cell extents a side where a corner moves fast, so
 // four or five buckets of the hash a side: up to this many before every cell is taken.
 constexpr long kMostCellBuckets = 125;
-// A cell's six edges in the order SelfContact::build_candidates numbers them (its sides at l, at
+// A cell's six edges in the order SelfContact::cell_edges gives them (its sides at l, at
 // l + 1, at k, at k + 1, its diagonals from (k, l) and from (k + 1, l)): each end's offsets in k
 // and l from the cell's first node.
 constexpr int kCellEdges[6][2][2] = {{{0, 0}, {1, 0}}, {{0, 1}, {1, 1}}, {{0, 0}, {0, 1}},
@@ -397,20 +397,21 @@ void SelfContact::present_cells() {
         present_[i + m + 1] != 0)
       present_cells_.push_back(static_cast<std::int32_t>(k + (m - 1) * l));
   }
-  // The edges of those cells that meet others (every edge, or the border's), in increasing
-  // number; with the border's alone, the cells that hold them (else every cell held does).
+  // The edges of those cells that meet others, in increasing number, and the cells that look
+  // up their pairs: their own cells (every cell held, or with the border's edges alone the cells
+  // along the border).
   present_edges_.clear();
-  for (std::size_t e = 0; e < border_edge_.size(); ++e) {
-    const auto cells = edge_cells(static_cast<std::int32_t>(e));
-    if ((every_edge_ || border_edge_[e] != 0) && (cell_present(cells[0]) || cell_present(cells[1])))
-      present_edges_.push_back(static_cast<std::int32_t>(e));
+  for (std::int32_t e = 0; e < static_cast<std::int32_t>(border_edge_.size()); ++e) {
+    const auto cells = edge_cells(e);
+    if (meets_others(e) && (cell_present(cells[0]) || cell_present(cells[1])))
+      present_edges_.push_back(e);
   }
-  border_cells_.clear();
-  if (every_edge_) return;
-  const std::int32_t m1 = block_->m - 1;
+  looked_up_.clear();
   for (const std::int32_t c : present_cells_) {
-    const std::int32_t ck = c % m1, cl = c / m1;
-    if (ck == 0 || ck == m1 - 1 || cl == 0 || cl == block_->n - 2) border_cells_.push_back(c);
+    const auto edges = cell_edges(c);
+    if (std::any_of(edges.begin(), edges.end(),
+                    [&](std::int32_t f) { return meets_others(f) && own_cell(f) == c; }))
+      looked_up_.push_back(c);
   }
 }
 
@@ -466,6 +467,23 @@ std::array<std::int32_t, 2> SelfContact::edge_cells(std::int32_t e) const {
     return {k > 0 ? k - 1 + (m - 1) * l : -1, k < m - 1 ? k + (m - 1) * l : -1};
   }
   return {(e - sides) % cells, -1};
+}
+
+std::array<std::int32_t, 6> SelfContact::cell_edges(std::int32_t c) const {
+  const std::int32_t m = block_->m, n = block_->n, horizontal = (m - 1) * n;
+  const std::int32_t diagonals = horizontal + m * (n - 1), cells = (m - 1) * (n - 1);
+  const std::int32_t ck = c % (m - 1), cl = c / (m - 1);
+  return {ck + (m - 1) * cl,
+          ck + (m - 1) * (cl + 1),
+          horizontal + ck + m * cl,
+          horizontal + ck + 1 + m * cl,
+          diagonals + c,
+          diagonals + cells + c};
+}
+
+std::int32_t SelfContact::own_cell(std::int32_t e) const {
+  const auto two = edge_cells(e);
+  return cell_present(two[0]) ? two[0] : two[1];
 }
 
 // Both diagonals, each at half weight: no diagonal is preferred (docs/contact.md, "Symmetry").
@@ -661,11 +679,7 @@ void SelfContact::build_candidates(double extent_sum) {
   // count. A cell's box spans more buckets than a node's: up to kMostCellBuckets are visited
   // before every cell is taken.
   const std::int32_t mi = block_->m;
-  const std::int32_t horizontal = (mi - 1) * block_->n;
-  const std::int32_t diagonals = horizontal + mi * (block_->n - 1);
-  const auto cells_i = static_cast<std::int32_t>(cells);
   near_start_.assign(cells + 1, 0);
-  const std::vector<std::int32_t>& looked_up = every_edge_ ? present_cells_ : border_cells_;
   for (std::vector<std::int32_t>& found : thread_lists_) found.clear();
 #pragma omp parallel
   {
@@ -673,8 +687,8 @@ void SelfContact::build_candidates(double extent_sum) {
     std::vector<std::int32_t>& found = thread_lists_[me];
     std::vector<std::int32_t>& candidates = thread_candidates_[me];
 #pragma omp for schedule(static)
-    for (std::size_t at = 0; at < looked_up.size(); ++at) {
-      const auto c = static_cast<std::size_t>(looked_up[at]);
+    for (std::size_t at = 0; at < looked_up_.size(); ++at) {
+      const auto c = static_cast<std::size_t>(looked_up_[at]);
       const Vec3 lo = grown(reach_lo_[c], -thickness_), hi = grown(reach_hi_[c], thickness_);
       const auto ck = static_cast<std::int64_t>(c % cells_k);
       const auto cl = static_cast<std::int64_t>(c / cells_k);
@@ -726,17 +740,12 @@ void SelfContact::build_candidates(double extent_sum) {
   // in k or l. Nearer edges are the fold of a cell or two, which the bending holds, and which a
   // cloth hung from a corner makes there: held apart, the corner's edges and those two cells on
   // fought the fold and threw a node (scenes/hard/denim_square.toml stopped at 2.35 s with them).
-  // An edge's own cell is the first of its two this rank holds. Its box holds the edge's, so two
-  // edges whose boxes meet have own cells that are near each other, or next to each other in the
-  // grid, where every node of one is within two of every node of the other: each pair is found
-  // once, from the first edge's own cell and the second's. (From both cells of each edge and all
-  // six edges of their near cells, most pairs were found two to four times.) The lower number's
-  // edge takes the pair, in increasing order, on the rank's threads in static chunks of the
-  // edges, joined in thread order.
-  auto own_cell = [&](std::int32_t e) {
-    const auto two = edge_cells(e);
-    return cell_present(two[0]) ? two[0] : two[1];
-  };
+  // An edge's own cell (own_cell) holds the edge's box, so two edges whose boxes meet have own
+  // cells that are near each other, or next to each other in the grid, where every node of one is
+  // within two of every node of the other: each pair is found once, from the first edge's own
+  // cell and the second's. (From both cells of each edge and all six edges of their near cells,
+  // most pairs were found two to four times.) The lower number's edge takes the pair, in
+  // increasing order, on the rank's threads in static chunks of the edges, joined in thread order.
   thread_edge_candidates_.resize(threads);
   for (auto& found : thread_edge_candidates_) found.clear();
 #pragma omp parallel
@@ -758,14 +767,12 @@ void SelfContact::build_candidates(double extent_sum) {
       for (std::uint32_t at_near = near_start_[o]; at_near < near_start_[o + 1]; ++at_near) {
         const std::int32_t cell = near_cells_[at_near];
         const std::int32_t ck = cell % (mi - 1), cl = cell / (mi - 1);
-        // The cell's edges in the order of kCellEdges, each with its nodes' offsets.
-        const std::int32_t numbers[6] = {ck + (mi - 1) * cl,        ck + (mi - 1) * (cl + 1),
-                                         horizontal + ck + mi * cl, horizontal + ck + 1 + mi * cl,
-                                         diagonals + cell,          diagonals + cells_i + cell};
+        // The cell's edges, each with its nodes' offsets in kCellEdges.
+        const auto numbers = cell_edges(cell);
         for (int j = 0; j < 6; ++j) {
-          const std::int32_t f = numbers[j];
+          const std::int32_t f = numbers[static_cast<std::size_t>(j)];
           // Every pair once: from the lower number's edge where both are listed.
-          if (f <= e && (every_edge_ || border_edge_[static_cast<std::size_t>(f)] != 0)) continue;
+          if (f <= e && meets_others(f)) continue;
           bool near = false;
           for (int end = 0; end < 2; ++end) {
             const std::int32_t fk = ck + kCellEdges[j][end][0], fl = cl + kCellEdges[j][end][1];

@@ -189,6 +189,15 @@ class SelfContact {
   // are held only where they cross (find_edge_pairs).
   std::array<std::int32_t, 2> edge_nodes(std::int32_t edge) const;
   std::array<std::int32_t, 2> edge_cells(std::int32_t edge) const;
+  // Cell c's six edges, in the order of kCellEdges (self_contact.cpp).
+  std::array<std::int32_t, 6> cell_edges(std::int32_t c) const;
+  // Whether an edge meets others under the rule (every edge, or the border's: every_edge_).
+  bool meets_others(std::int32_t edge) const {
+    return every_edge_ || border_edge_[static_cast<std::size_t>(edge)] != 0;
+  }
+  // An edge's own cell: the first of its two this rank holds. Each pair of edges is found from
+  // the two own cells alone (build_candidates).
+  std::int32_t own_cell(std::int32_t edge) const;
   bool through_cell(std::int32_t p, std::int32_t q, std::int32_t cell) const;
   std::vector<char> border_edge_;  // over every edge: 1 on the cloth's border
   // The edges of the cells held that meet others (every edge, or the border's: every_edge_), in
@@ -199,7 +208,7 @@ class SelfContact {
   std::vector<std::uint32_t> near_start_;
   std::vector<std::int32_t> near_cells_;
   std::vector<char> near_mark_;           // a cell with near cells, or near another's
-  std::vector<std::int32_t> border_cells_;  // with the border's edges alone: the cells they bound
+  std::vector<std::int32_t> looked_up_;   // the own cells of present_edges_, in increasing order
   std::vector<Vec3> edge_lo_, edge_hi_;   // an edge's box over the step at the build (grown)
   struct EdgeCandidate {
     std::int32_t e, f;
